@@ -1,0 +1,31 @@
+#pragma once
+// The result of a mapping: one displacement vector per start point.
+#include <morphomap/types.hpp>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace morphomap {
+
+// The basic algorithm that produced a vector.
+enum class Method : std::int8_t { minimal_distance = 0, normal = 1, diffusion = 2, uniform = 3 };
+
+// "minimal_distance", "normal", "diffusion" or "uniform".
+std::string method_name(Method method);
+
+// Vectors starts[i] -> ends[i] from C1 to C2, in the order of the points of the curve the
+// algorithm mapped from. A row whose algorithm found no target is NaN in ends (and, for a
+// reverse mapping, in starts too).
+struct DisplacementField2 {
+  Points2 starts;
+  Points2 ends;
+  std::vector<Method> methods;
+
+  Index size() const { return starts.rows(); }
+  bool valid(Index i) const {
+    return starts.row(i).allFinite() && ends.row(i).allFinite();
+  }
+};
+
+}  // namespace morphomap

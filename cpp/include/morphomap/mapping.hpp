@@ -1,0 +1,28 @@
+#pragma once
+// Displacement fields between two curves: the paper's basic algorithms and extensions.
+#include <morphomap/field.hpp>
+#include <morphomap/types.hpp>
+
+#include <optional>
+
+namespace morphomap {
+
+enum class MapMethod { minimal_distance, normal, diffusion, uniform, automatic };
+
+struct CurveMappingOptions {
+  MapMethod method = MapMethod::normal;
+  bool closed = true;       // both curves closed, or both open
+  Index n = 0;              // 0: the given points of the source curve are the start points;
+                            // > 0: both curves are first resampled to n equally spaced points
+  bool reverse = false;     // map C2 -> C1 and flip the vectors
+  bool transform = false;   // Appendix A: align a scaled C1 with C2 first, then carry back
+  bool split = true;        // map each pair of segments between intersection points on its own
+  std::optional<Vec2> anchor;  // uniform mapping of closed curves that do not cross: a point
+                               // of C1 (its nearest curve point) that maps onto its nearest
+                               // point of C2
+};
+
+DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2,
+                              const CurveMappingOptions& options = {});
+
+}  // namespace morphomap

@@ -1,0 +1,13 @@
+#pragma once
+// Everything of the public C++ API.
+#include <morphomap/build_info.hpp>
+#include <morphomap/crossings.hpp>
+#include <morphomap/curve_geometry.hpp>
+#include <morphomap/curve_queries.hpp>
+#include <morphomap/errors.hpp>
+#include <morphomap/field.hpp>
+#include <morphomap/mapping.hpp>
+#include <morphomap/quality.hpp>
+#include <morphomap/resample.hpp>
+#include <morphomap/transform.hpp>
+#include <morphomap/types.hpp>

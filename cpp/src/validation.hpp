@@ -1,0 +1,29 @@
+#pragma once
+// Input checks shared by the kernels. Messages start with the argument's name so that the
+// Python layer can pass them on unchanged.
+#include <morphomap/errors.hpp>
+#include <morphomap/types.hpp>
+
+#include <string>
+
+namespace morphomap::detail {
+
+[[noreturn]] void invalid(const char* name, const std::string& problem);
+
+// Every coordinate finite.
+void require_finite(const Points2Ref& points, const char* name);
+
+// Points that take part: a closed curve whose last point repeats its first drops the last.
+Index curve_size(const Points2Ref& points, bool closed);
+
+// Finite, at least 2 (open) or 3 (closed) points, and a non-zero length. Returns curve_size.
+Index require_curve(const Points2Ref& points, bool closed, const char* name);
+
+// The curve without exact consecutive repeats (nor a closing repeat when closed), checked to
+// still have enough points.
+Points2 without_repeats(const Points2Ref& points, bool closed, const char* name);
+
+// Number of worker threads the kernels use.
+int thread_count();
+
+}  // namespace morphomap::detail

@@ -1,0 +1,49 @@
+"""morphomap: displacement fields between the boundaries of a growing organ.
+
+Maps curve C1 (time t) onto curve C2 (time t + dt) in 2D, or one closed surface onto another in 3D,
+with the algorithms of Schwaninger, Menshykau and Iber (minimal distance, normal, diffusion,
+uniform) and their extensions and quality measures.
+"""
+
+from ._core import GeometryError, InvalidInput
+from ._core import build_info as _build_info
+from .crossings import count_crossings, crossing_pairs
+from .curves import (
+    arc_lengths,
+    curve_intersections,
+    is_self_intersecting,
+    normals,
+    orientation,
+    perimeter,
+    resample,
+    signed_area,
+)
+from .queries import CurveHits, CurveIndex, closest_points, line_intersections
+
+__version__ = _build_info()["version"]
+
+
+def build_info() -> dict:
+    """Versions of morphomap and of CGAL, Embree, Eigen and TBB it was built against, and threads."""
+    return dict(_build_info())
+
+
+__all__ = [
+    "CurveHits",
+    "CurveIndex",
+    "GeometryError",
+    "InvalidInput",
+    "arc_lengths",
+    "build_info",
+    "closest_points",
+    "count_crossings",
+    "crossing_pairs",
+    "curve_intersections",
+    "is_self_intersecting",
+    "line_intersections",
+    "normals",
+    "orientation",
+    "perimeter",
+    "resample",
+    "signed_area",
+]

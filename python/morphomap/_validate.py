@@ -1,0 +1,60 @@
+"""Argument checks shared by the public functions.
+
+Every array goes to the C++ core as a float64, C-contiguous copy or view, so the core can take it
+without copying. Errors name the argument: ``TypeError`` for a wrong kind of object, ``ValueError``
+for a wrong shape or value.
+"""
+
+from __future__ import annotations
+
+import numbers
+
+import numpy as np
+
+
+def as_points(value, name: str, dim: int = 2, *, allow_nan: bool = False) -> np.ndarray:
+    """Return ``value`` as a C-contiguous float64 array of shape (N, dim).
+
+    Integer arrays are converted; booleans, strings, objects and complex numbers are refused.
+    """
+    if isinstance(value, (str, bytes)) or value is None:
+        raise TypeError(f"{name}: expected an array of shape (N, {dim}), got {type(value).__name__}")
+    try:
+        array = np.asarray(value)
+    except (ValueError, TypeError) as error:  # ragged nested lists
+        raise ValueError(f"{name}: cannot be read as an array of shape (N, {dim}): {error}") from None
+    if array.dtype == bool or not (np.issubdtype(array.dtype, np.integer) or np.issubdtype(array.dtype, np.floating)):
+        raise TypeError(f"{name}: expected real numbers, got an array of dtype {array.dtype}")
+    if array.ndim != 2 or array.shape[1] != dim:
+        raise ValueError(f"{name}: expected shape (N, {dim}), got {array.shape}")
+    array = np.ascontiguousarray(array, dtype=np.float64)
+    if not allow_nan and not np.isfinite(array).all():
+        row = int(np.flatnonzero(~np.isfinite(array).all(axis=1))[0])
+        raise ValueError(f"{name}: row {row} has a non-finite coordinate")
+    return array
+
+
+def as_count(value, name: str, minimum: int) -> int:
+    """Return ``value`` as a Python int of at least ``minimum``."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{name}: expected an integer, got {type(value).__name__}")
+    value = int(value)
+    if value < minimum:
+        raise ValueError(f"{name}: must be at least {minimum}, got {value}")
+    return value
+
+
+def as_flag(value, name: str) -> bool:
+    """Return ``value`` as a bool; only True and False are accepted."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name}: expected True or False, got {type(value).__name__}")
+    return bool(value)
+
+
+def as_choice(value, name: str, choices: tuple[str, ...]) -> str:
+    """Return ``value`` if it is one of ``choices``."""
+    if not isinstance(value, str):
+        raise TypeError(f"{name}: expected one of {', '.join(map(repr, choices))}, got {type(value).__name__}")
+    if value not in choices:
+        raise ValueError(f"{name}: expected one of {', '.join(map(repr, choices))}, got {value!r}")
+    return value

@@ -1,0 +1,31 @@
+"""Shapes with closed-form geometry, shared by the tests."""
+
+import numpy as np
+import pytest
+
+
+def circle(n, radius=1.0, centre=(0.0, 0.0), clockwise=False):
+    """n points on a circle, starting at angle 0."""
+    angles = 2 * np.pi * np.arange(n) / n
+    if clockwise:
+        angles = -angles
+    return np.column_stack([centre[0] + radius * np.cos(angles), centre[1] + radius * np.sin(angles)])
+
+
+def ellipse(n, a, b, centre=(0.0, 0.0)):
+    """n points on the ellipse x^2/a^2 + y^2/b^2 = 1, equally spaced in the parameter angle."""
+    angles = 2 * np.pi * np.arange(n) / n
+    return np.column_stack([centre[0] + a * np.cos(angles), centre[1] + b * np.sin(angles)])
+
+
+@pytest.fixture
+def rng():
+    return np.random.default_rng(20141)
+
+
+@pytest.fixture
+def wobbly():
+    """A non-convex closed curve (a star-like blob) with 700 points."""
+    t = 2 * np.pi * np.arange(700) / 700
+    r = 1.0 + 0.3 * np.sin(5 * t) + 0.1 * np.cos(11 * t)
+    return np.column_stack([r * np.cos(t), r * np.sin(t)])
