@@ -3,8 +3,6 @@
 #include "segment_pairs.hpp"
 #include "validation.hpp"
 
-#include <tbb/parallel_reduce.h>
-
 #include <cmath>
 #include <string>
 
@@ -60,22 +58,14 @@ bool crossing(const Segments& s, Index i, Index j) {
 
 std::vector<std::pair<Index, Index>> crossing_pairs(const Points2Ref& starts, const Points2Ref& ends) {
   const Segments s = read_segments(starts, ends);
-  return detail::filter_pairs(detail::overlapping_pairs(s.boxes),
-                              [&](Index i, Index j) { return crossing(s, i, j); });
+  detail::IndexPairs pairs;
+  detail::test_overlapping_pairs(s.boxes, [&](Index i, Index j) { return crossing(s, i, j); }, &pairs);
+  return pairs;
 }
 
 Index count_crossings(const Points2Ref& starts, const Points2Ref& ends) {
   const Segments s = read_segments(starts, ends);
-  const detail::IndexPairs pairs = detail::overlapping_pairs(s.boxes);
-  return tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, pairs.size()), Index(0),
-      [&](const tbb::blocked_range<std::size_t>& r, Index count) {
-        for (std::size_t k = r.begin(); k != r.end(); ++k) {
-          count += crossing(s, pairs[k].first, pairs[k].second) ? 1 : 0;
-        }
-        return count;
-      },
-      [](Index x, Index y) { return x + y; });
+  return detail::test_overlapping_pairs(s.boxes, [&](Index i, Index j) { return crossing(s, i, j); });
 }
 
 }  // namespace morphomap

@@ -139,7 +139,7 @@ bool is_self_intersecting(const Points2Ref& points, bool closed) {
     }
     return detail::segments_meet(p[i], p[(i + 1) % m], p[j], p[(j + 1) % m]);
   };
-  return !detail::filter_pairs(detail::overlapping_pairs(boxes), hit).empty();
+  return detail::test_overlapping_pairs(boxes, hit) > 0;
 }
 
 }  // namespace morphomap

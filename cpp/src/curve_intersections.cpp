@@ -190,9 +190,9 @@ std::vector<Index> drop_touches(const Curve& c1, const Curve& c2, const std::vec
 
 CurveIntersections curve_intersections(const Points2Ref& c1, const Points2Ref& c2, bool closed) {
   const Curve a(c1, closed, "c1"), b(c2, closed, "c2");
-  const detail::IndexPairs hits =
-      detail::filter_pairs(detail::overlapping_pairs(a.boxes(), b.boxes()),
-                           [&](Index i, Index j) { return shifted_cross(a, i, b, j); });
+  detail::IndexPairs hits;
+  detail::test_overlapping_pairs(
+      a.boxes(), b.boxes(), [&](Index i, Index j) { return shifted_cross(a, i, b, j); }, &hits);
 
   std::vector<Crossing> x;
   x.reserve(hits.size());

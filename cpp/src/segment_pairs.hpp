@@ -63,50 +63,75 @@ struct SegmentBox {
 
 using IndexPairs = std::vector<std::pair<Index, Index>>;
 
-// All pairs (i < j) of boxes that overlap (closed boxes: touching counts), sorted.
-inline IndexPairs overlapping_pairs(std::vector<SegmentBox> boxes) {
-  IndexPairs pairs;
+// Collects candidate pairs from a box search and tests them on all cores in batches, so that
+// memory stays bounded however many boxes overlap (long vectors of a dense field overlap by the
+// million). Counts the pairs for which keep(i, j) holds and, given `kept`, stores them sorted.
+template <class Keep>
+class PairTester {
+ public:
+  PairTester(const Keep& keep, IndexPairs* kept) : keep_(keep), kept_(kept) { batch_.reserve(batch_size); }
+  void add(Index i, Index j) {
+    batch_.emplace_back(i, j);
+    if (batch_.size() == batch_size) flush();
+  }
+  Index finish() {
+    flush();
+    if (kept_ != nullptr) std::sort(kept_->begin(), kept_->end());
+    return count_;
+  }
+
+ private:
+  static constexpr std::size_t batch_size = std::size_t(1) << 20;
+  void flush() {
+    flags_.assign(batch_.size(), 0);
+    tbb::parallel_for(std::size_t(0), batch_.size(), [&](std::size_t k) {
+      flags_[k] = keep_(batch_[k].first, batch_[k].second) ? 1 : 0;
+    });
+    for (std::size_t k = 0; k < batch_.size(); ++k) {
+      if (!flags_[k]) continue;
+      ++count_;
+      if (kept_ != nullptr) kept_->push_back(batch_[k]);
+    }
+    batch_.clear();
+  }
+  const Keep& keep_;
+  IndexPairs* kept_;
+  IndexPairs batch_;
+  std::vector<char> flags_;
+  Index count_ = 0;
+};
+
+// Pairs (i < j) of overlapping boxes (closed: touching counts) for which keep(i, j) holds:
+// returns their number and, given `kept`, stores them sorted. keep runs concurrently.
+template <class Keep>
+Index test_overlapping_pairs(std::vector<SegmentBox> boxes, const Keep& keep, IndexPairs* kept = nullptr) {
+  PairTester<Keep> tester(keep, kept);
+  // Each overlapping pair is reported once.
   CGAL::box_self_intersection_d(
       boxes.begin(), boxes.end(),
       [&](const SegmentBox& a, const SegmentBox& b) {
         const Index i = static_cast<Index>(a.index), j = static_cast<Index>(b.index);
-        pairs.emplace_back(std::min(i, j), std::max(i, j));
+        tester.add(std::min(i, j), std::max(i, j));
       },
       std::ptrdiff_t(10), CGAL::Box_intersection_d::CLOSED);
-  std::sort(pairs.begin(), pairs.end());
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-  return pairs;
+  return tester.finish();
 }
 
-// All pairs (i, j) with box i of `first` overlapping box j of `second`, sorted. The boxes'
-// index fields are positions in their own set.
-inline IndexPairs overlapping_pairs(std::vector<SegmentBox> first, std::vector<SegmentBox> second) {
+// The same for pairs (i, j), box i of `first` overlapping box j of `second`; the boxes' index
+// fields are positions in their own set.
+template <class Keep>
+Index test_overlapping_pairs(std::vector<SegmentBox> first, std::vector<SegmentBox> second,
+                             const Keep& keep, IndexPairs* kept = nullptr) {
   const std::size_t offset = first.size();
   for (SegmentBox& box : second) box.index += offset;
-  IndexPairs pairs;
+  PairTester<Keep> tester(keep, kept);
   CGAL::box_intersection_d(
       first.begin(), first.end(), second.begin(), second.end(),
       [&](const SegmentBox& a, const SegmentBox& b) {
-        pairs.emplace_back(static_cast<Index>(a.index), static_cast<Index>(b.index - offset));
+        tester.add(static_cast<Index>(a.index), static_cast<Index>(b.index - offset));
       },
       std::ptrdiff_t(10), CGAL::Box_intersection_d::CLOSED);
-  std::sort(pairs.begin(), pairs.end());
-  return pairs;
-}
-
-// The pairs for which keep(i, j) is true, in their order. The tests run on all cores; keep must
-// be safe to call concurrently.
-template <class Keep>
-IndexPairs filter_pairs(const IndexPairs& pairs, const Keep& keep) {
-  std::vector<char> kept(pairs.size(), 0);
-  tbb::parallel_for(std::size_t(0), pairs.size(), [&](std::size_t k) {
-    kept[k] = keep(pairs[k].first, pairs[k].second) ? 1 : 0;
-  });
-  IndexPairs out;
-  for (std::size_t k = 0; k < pairs.size(); ++k) {
-    if (kept[k]) out.push_back(pairs[k]);
-  }
-  return out;
+  return tester.finish();
 }
 
 }  // namespace morphomap::detail

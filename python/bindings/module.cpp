@@ -9,6 +9,9 @@
 namespace py = pybind11;
 
 void bind_curves(py::module_& m);
+void bind_mapping(py::module_& m);
+void bind_transform(py::module_& m);
+void bind_quality(py::module_& m);
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "morphomap C++ core (use the morphomap package, not this module)";
@@ -27,4 +30,7 @@ PYBIND11_MODULE(_core, m) {
     return d;
   });
   bind_curves(m);
+  bind_mapping(m);
+  bind_transform(m);
+  bind_quality(m);
 }

@@ -18,7 +18,14 @@ from .curves import (
     resample,
     signed_area,
 )
+from .diffusion import DiffusionSolution, solve_diffusion
+from .field import DisplacementField
+from .io import load_example, read_curve, read_field, write_curve, write_field
+from .mapping import map_curves
+from .plot import plot_field
+from .quality import CurveQuality, quality
 from .queries import CurveHits, CurveIndex, closest_points, line_intersections
+from .transform import Similarity, align_curves, overlap_area
 
 __version__ = _build_info()["version"]
 
@@ -31,8 +38,13 @@ def build_info() -> dict:
 __all__ = [
     "CurveHits",
     "CurveIndex",
+    "CurveQuality",
+    "DiffusionSolution",
+    "DisplacementField",
     "GeometryError",
     "InvalidInput",
+    "Similarity",
+    "align_curves",
     "arc_lengths",
     "build_info",
     "closest_points",
@@ -41,9 +53,19 @@ __all__ = [
     "curve_intersections",
     "is_self_intersecting",
     "line_intersections",
+    "load_example",
+    "map_curves",
     "normals",
     "orientation",
+    "overlap_area",
     "perimeter",
+    "plot_field",
+    "quality",
+    "read_curve",
+    "read_field",
     "resample",
     "signed_area",
+    "write_curve",
+    "write_field",
+    "solve_diffusion",
 ]

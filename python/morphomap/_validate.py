@@ -58,3 +58,13 @@ def as_choice(value, name: str, choices: tuple[str, ...]) -> str:
     if value not in choices:
         raise ValueError(f"{name}: expected one of {', '.join(map(repr, choices))}, got {value!r}")
     return value
+
+
+def as_point(value, name: str, dim: int = 2) -> np.ndarray:
+    """Return one point given as a sequence of ``dim`` finite numbers as a float64 ``(dim,)`` array."""
+    if isinstance(value, (str, bytes)):
+        raise TypeError(f"{name}: expected {dim} coordinates, got {type(value).__name__}")
+    array = np.asarray(value)
+    if array.shape != (dim,):
+        raise ValueError(f"{name}: expected {dim} coordinates, got shape {array.shape}")
+    return as_points(array.reshape(1, dim), name, dim)[0]

@@ -19,13 +19,113 @@ def _info(args) -> int:
     return 0
 
 
+def _demo(args) -> int:
+    from .demo import run
+
+    rows = run(args.out)
+    failed = [row for row in rows if row.note.startswith("failed")]
+    if failed:
+        print(f"morphomap demo: {len(failed)} mappings failed (see the table)", file=sys.stderr)
+        return 1
+    return 0
+
+
+def _map(args, parser) -> int:
+    import morphomap
+
+    from .io import read_curve, write_field
+    from .mapping import map_curves
+    from .quality import quality
+
+    curves = []
+    for path in (args.c1, args.c2):
+        try:
+            curves.append(read_curve(path))
+        except OSError as error:
+            parser.error(f"cannot read {path}: {error.strerror or error}")
+        except ValueError as error:
+            parser.error(str(error))
+    c1, c2 = curves
+    try:
+        field = map_curves(c1, c2, args.method, closed=args.closed, n=args.n, reverse=args.reverse,
+                           transform=args.transform, split=args.split)
+    except (ValueError, TypeError, morphomap.InvalidInput, morphomap.GeometryError) as error:
+        if args.method == "auto" and "auto" in str(error):
+            parser.error(f"--method auto is not available in this version ({error}); "
+                         "choose --method minimal_distance, normal or uniform")
+        parser.error(f"cannot map {args.c1} onto {args.c2} with --method {args.method}: {error}")
+    q = quality(field, c1, c2, closed=args.closed) if field.dim == 2 else None
+    try:
+        write_field(sys.stdout if args.output == "-" else args.output, field)
+        if args.plot:
+            from matplotlib.figure import Figure
+
+            from .plot import plot_field
+
+            fig = Figure(figsize=(7, 7), layout="constrained")
+            plot_field(field, c1, c2, ax=fig.subplots(), closed=args.closed,
+                       title=f"{args.method}: QM1 {q.qm1:.4g}  QM2 {q.qm2:.4g}  QM {q.qm:.4g}")
+            fig.savefig(args.plot, dpi=100)
+    except OSError as error:
+        parser.error(f"cannot write {error.filename}: {error.strerror or error}")
+    summary = (f"{len(field)} vectors, {int(field.valid.sum())} valid, {int((~field.valid).sum())} misses; "
+               f"QM1 {q.qm1:.4g}  QM2 {q.qm2:.4g}  QM {q.qm:.4g}  crossings {q.crossings}")
+    where = "" if args.output == "-" else f"; field written to {args.output}"
+    where += f", plot to {args.plot}" if args.plot else ""
+    print(summary + where, file=sys.stderr)
+    return 0
+
+
 def main(argv=None) -> int:
+    from .mapping import CURVE_METHODS
+
     parser = argparse.ArgumentParser(prog="morphomap", description="Displacement fields between growing boundaries.")
     commands = parser.add_subparsers(dest="command", required=True)
     info = commands.add_parser("info", help="print the version, the libraries it was built against and the threads it uses")
     info.set_defaults(run=_info)
+    demo = commands.add_parser(
+        "demo", help="run every algorithm on the bundled example curves; write fields, figures and the quality table",
+        description="Map the bundled example pairs with every algorithm (plain, reverse, transformed; all with the "
+                    "curves split where they cross), print the quality table and write the fields (CSV) and "
+                    "figures (PNG).")
+    demo.add_argument("--out", default="morphomap-demo", metavar="DIR",
+                      help="folder to write into (default: ./morphomap-demo)")
+    demo.set_defaults(run=_demo)
+    mapping = commands.add_parser(
+        "map", help="map curve C1 onto curve C2 (CSV files of x,y rows) and write the displacement field",
+        description="Map curve C1 (time t) onto curve C2 (time t + dt). Curves: CSV files of x,y rows, with an "
+                    "optional header. Prints the vector count and quality measures to stderr.")
+    mapping.add_argument("c1", metavar="C1", help="CSV file of the curve at time t")
+    mapping.add_argument("c2", metavar="C2", help="CSV file of the curve at time t + dt")
+    mapping.add_argument("--method", default="auto", choices=CURVE_METHODS, help="the algorithm (default: auto)")
+    closed = mapping.add_mutually_exclusive_group()
+    closed.add_argument("--closed", dest="closed", action="store_true", default=True,
+                        help="the curves are closed (the default)")
+    closed.add_argument("--open", dest="closed", action="store_false", help="the curves are open")
+    mapping.add_argument("--n", type=_positive, default=None, metavar="N",
+                         help="resample both curves to N equally spaced points first")
+    mapping.add_argument("--reverse", action="store_true", help="map C2 onto C1 and flip the vectors")
+    mapping.add_argument("--transform", action="store_true",
+                         help="move C1 close to C2 first (the paper's Appendix A), then map")
+    mapping.add_argument("--no-split", dest="split", action="store_false",
+                         help="do not split the curves where they cross")
+    mapping.add_argument("-o", "--output", default="-", metavar="FIELD.csv",
+                         help="where to write the field (columns start_x,start_y,end_x,end_y,valid,method); "
+                              "default: standard output")
+    mapping.add_argument("--plot", metavar="FIELD.png", help="also draw the field into this image file")
+    mapping.set_defaults(run=lambda args: _map(args, mapping))
     args = parser.parse_args(argv)
     return args.run(args)
+
+
+def _positive(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if value < 2:
+        raise argparse.ArgumentTypeError(f"expected at least 2, got {value}")
+    return value
 
 
 if __name__ == "__main__":

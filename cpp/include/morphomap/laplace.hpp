@@ -1,0 +1,37 @@
+#pragma once
+// Diffusion mapping: the Laplace equation in the region between two curves, and its streamlines.
+#include <morphomap/types.hpp>
+
+#include <vector>
+
+namespace morphomap {
+
+using Triangles = Eigen::Matrix<Index, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+struct DiffusionOptions {
+  // Longest edge of the region mesh; 0 picks mesh_fraction * the mean gap between the curves
+  // (twice the region's area over its boundary length). Near the curves the mesh is graded from
+  // their point spacing and refined where the gap is narrow, whatever this bound.
+  double mesh_size = 0.0;
+  double mesh_fraction = 0.02;
+  bool keep_streamlines = false;
+};
+
+struct DiffusionSolution {
+  Points2 vertices;     // the region mesh: every point of both curves is a vertex
+  Triangles triangles;  // counter-clockwise
+  Vector potential;     // c at the vertices: P1 finite elements, c = 1 on the source, 0 on the target
+  Points2 ends;         // for each source point, where its streamline of -grad c meets the target
+                        // (NaN if it does not)
+  std::vector<Points2> streamlines;  // with keep_streamlines: one polyline per source point
+};
+
+// The region between source and target: closed curves must be nested (an annulus) or cross (each
+// lobe of their symmetric difference on its own); open curves are joined start to start and end to
+// end by straight edges where c is free (no flux). Streamlines are traced exactly in the P1
+// solution, whose gradient is constant on each triangle: straight inside a triangle, along an
+// edge where the flows of its two triangles meet.
+DiffusionSolution solve_diffusion(const Points2Ref& source, const Points2Ref& target,
+                                  bool closed = true, const DiffusionOptions& options = {});
+
+}  // namespace morphomap

@@ -1,0 +1,381 @@
+// P1 finite elements for the Laplace equation on the region mesh, and exact streamline tracing.
+#include <morphomap/curve_geometry.hpp>
+#include <morphomap/curve_queries.hpp>
+#include <morphomap/errors.hpp>
+#include <morphomap/laplace.hpp>
+
+#include "region_mesh.hpp"
+#include "validation.hpp"
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace morphomap {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+enum Kind : char { free_vertex = 0, source_vertex = 1, target_vertex = 2 };
+
+double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+// Even-odd test; only used for curves known not to cross.
+bool inside(const Vec2& p, const Points2& polygon) {
+  bool in = false;
+  const Index n = polygon.rows();
+  for (Index i = 0, j = n - 1; i < n; j = i++) {
+    const double yi = polygon(i, 1), yj = polygon(j, 1);
+    if ((yi > p.y()) != (yj > p.y())) {
+      const double x = polygon(j, 0) + (p.y() - yj) * (polygon(i, 0) - polygon(j, 0)) / (yi - yj);
+      if (p.x() < x) in = !in;
+    }
+  }
+  return in;
+}
+
+// Solves the Dirichlet problem: c fixed where kind != free, harmonic elsewhere.
+Vector solve_potential(const detail::RegionMesh& mesh, const std::vector<char>& kind) {
+  const Index n = mesh.vertices.rows();
+  std::vector<Index> unknown(n, -1);
+  Index free_count = 0;
+  Vector c(n);
+  for (Index v = 0; v < n; ++v) {
+    if (kind[v] == free_vertex) unknown[v] = free_count++;
+    c[v] = kind[v] == source_vertex ? 1.0 : 0.0;
+  }
+  if (free_count == 0) return c;
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(9 * mesh.triangles.rows());
+  Vector rhs = Vector::Zero(free_count);
+  for (Index t = 0; t < mesh.triangles.rows(); ++t) {
+    Vec2 p[3];
+    for (int i = 0; i < 3; ++i) p[i] = mesh.vertices.row(mesh.triangles(t, i)).transpose();
+    const double area2 = cross(p[1] - p[0], p[2] - p[0]);
+    for (int i = 0; i < 3; ++i) {
+      const Vec2 ei = p[(i + 2) % 3] - p[(i + 1) % 3];
+      for (int j = 0; j < 3; ++j) {
+        const Vec2 ej = p[(j + 2) % 3] - p[(j + 1) % 3];
+        const double k = ei.dot(ej) / (2.0 * area2);  // grad phi_i . grad phi_j * area
+        const Index vi = mesh.triangles(t, i), vj = mesh.triangles(t, j);
+        if (unknown[vi] < 0) continue;
+        if (unknown[vj] >= 0) {
+          entries.emplace_back(unknown[vi], unknown[vj], k);
+        } else {
+          rhs[unknown[vi]] -= k * c[vj];
+        }
+      }
+    }
+  }
+  Eigen::SparseMatrix<double> stiffness(free_count, free_count);
+  stiffness.setFromTriplets(entries.begin(), entries.end());
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(stiffness);
+  if (solver.info() != Eigen::Success) {
+    throw GeometryError("the Laplace system is singular: a part of the region touches neither curve");
+  }
+  const Vector x = solver.solve(rhs);
+  for (Index v = 0; v < n; ++v) {
+    if (unknown[v] >= 0) c[v] = x[unknown[v]];
+  }
+  return c;
+}
+
+// Follows -grad c from a vertex of the source until it meets the target. The P1 gradient is
+// constant on each triangle; tracing it exactly is first-order accurate (streamlines zigzag and
+// merge along edges). So it is first recovered at the vertices (the area-weighted mean over the
+// triangles around each) and interpolated linearly: a continuous flow whose streamlines do not
+// cross, second-order accurate, crossed triangle by triangle in RK4 steps of a fraction of the
+// triangle's size.
+class Tracer {
+ public:
+  Tracer(const detail::RegionMesh& mesh, const Vector& c, const std::vector<char>& kind)
+      : mesh_(mesh), c_(c), kind_(kind), step_(mesh.triangles.rows()) {
+    const Index n = mesh.vertices.rows(), triangles = mesh.triangles.rows();
+    offsets_.assign(n + 1, 0);
+    for (Index t = 0; t < triangles; ++t) {
+      for (int i = 0; i < 3; ++i) ++offsets_[mesh.triangles(t, i) + 1];
+    }
+    for (Index v = 0; v < n; ++v) offsets_[v + 1] += offsets_[v];
+    incident_.resize(offsets_[n]);
+    std::vector<Index> fill(offsets_.begin(), offsets_.end() - 1);
+    std::vector<double> weight(n, 0.0);
+    velocity_.assign(n, Vec2::Zero());
+    for (Index t = 0; t < triangles; ++t) {
+      Vec2 p[3];
+      for (int i = 0; i < 3; ++i) {
+        incident_[fill[mesh.triangles(t, i)]++] = t;
+        p[i] = point(mesh.triangles(t, i));
+      }
+      const double area2 = cross(p[1] - p[0], p[2] - p[0]);
+      // -grad c = -sum_i c_i grad phi_i, grad phi_i = rot(edge opposite i) / (2 area).
+      Vec2 flow = Vec2::Zero();
+      double longest = 0.0;
+      for (int i = 0; i < 3; ++i) {
+        const Vec2 e = p[(i + 2) % 3] - p[(i + 1) % 3];
+        flow -= c_[mesh.triangles(t, i)] * Vec2(-e.y(), e.x()) / area2;
+        longest = std::max(longest, e.norm());
+      }
+      for (int i = 0; i < 3; ++i) {
+        velocity_[mesh.triangles(t, i)] += area2 * flow;
+        weight[mesh.triangles(t, i)] += area2;
+      }
+      step_[t] = 0.25 * area2 / longest;  // a quarter of the smallest height
+    }
+    for (Index v = 0; v < n; ++v) velocity_[v] /= weight[v];
+    // On the curves c is constant, so the flow is normal to them: keep only the normal part of
+    // the one-sided average there (the normal from the boundary edges at the vertex).
+    std::vector<Vec2> normal(n, Vec2::Zero());
+    for (Index t = 0; t < triangles; ++t) {
+      for (int i = 0; i < 3; ++i) {
+        if (mesh.neighbours(t, i) >= 0) continue;
+        const Index a = mesh.triangles(t, (i + 1) % 3), b = mesh.triangles(t, (i + 2) % 3);
+        if (kind[a] == free_vertex || kind[a] != kind[b]) continue;
+        const Vec2 e = point(b) - point(a);
+        normal[a] += Vec2(e.y(), -e.x());
+        normal[b] += Vec2(e.y(), -e.x());
+      }
+    }
+    for (Index v = 0; v < n; ++v) {
+      if (kind[v] == free_vertex || normal[v].squaredNorm() == 0.0) continue;
+      const Vec2 unit = normal[v].normalized();
+      velocity_[v] = velocity_[v].dot(unit) * unit;
+    }
+    step_limit_ = 40 * (triangles + n) + 1000;
+  }
+
+  Vec2 trace(Index start, std::vector<Vec2>* path) const {
+    const Vec2 lost(kNaN, kNaN);
+    auto record = [&](const Vec2& q) {
+      if (path) path->push_back(q);
+    };
+    Index vertex = start, t = -1;
+    Vec2 x = point(start);
+    record(x);
+    for (Index step = 0; step < step_limit_; ++step) {
+      if (vertex >= 0) {
+        if (kind_[vertex] == target_vertex && vertex != start) return point(vertex);
+        t = enter(vertex);
+        if (t < 0) {
+          if (!descend_edge(vertex)) return lost;
+          record(point(vertex));
+          continue;
+        }
+        x = point(vertex);
+        vertex = -1;
+      }
+      const double h = step_[t];
+      const Vec2 k1 = direction(t, x), k2 = direction(t, x + 0.5 * h * k1),
+                 k3 = direction(t, x + 0.5 * h * k2), k4 = direction(t, x + h * k3);
+      if (k1.squaredNorm() == 0.0) {  // no flow here: continue from the lowest corner
+        vertex = lowest_corner(t);
+        if (c_[vertex] >= c_at(t, x)) return lost;
+        record(point(vertex));
+        continue;
+      }
+      const Vec2 y = x + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+      const Eigen::Vector3d ly = barycentric(t, y);
+      if (ly.minCoeff() >= 0.0) {
+        x = y;
+        record(x);
+        continue;
+      }
+      // The step leaves t: through the edge whose coordinate reaches zero first.
+      const Eigen::Vector3d lx = barycentric(t, x);
+      int edge = -1;
+      double first = 2.0;
+      for (int i = 0; i < 3; ++i) {
+        if (ly[i] >= 0.0) continue;
+        const double s = std::max(lx[i], 0.0) / (std::max(lx[i], 0.0) - ly[i]);
+        if (s < first) first = s, edge = i;
+      }
+      const Vec2 p = x + first * (y - x);
+      const Index a = mesh_.triangles(t, (edge + 1) % 3), b = mesh_.triangles(t, (edge + 2) % 3);
+      const Index next = mesh_.neighbours(t, edge);
+      record(p);
+      if (next < 0) {
+        if (kind_[a] == target_vertex && kind_[b] == target_vertex) return p;
+        vertex = c_[a] <= c_[b] ? a : b;  // a boundary without flux: slide along it downhill
+        record(point(vertex));
+        continue;
+      }
+      t = next;
+      x = barycentric(t, y).minCoeff() >= 0.0 ? y : p;  // finish the step inside the neighbour
+    }
+    return lost;
+  }
+
+ private:
+  Vec2 point(Index v) const { return mesh_.vertices.row(v).transpose(); }
+
+  Eigen::Vector3d barycentric(Index t, const Vec2& x) const {
+    const Vec2 p0 = point(mesh_.triangles(t, 0)), p1 = point(mesh_.triangles(t, 1)), p2 = point(mesh_.triangles(t, 2));
+    const double area2 = cross(p1 - p0, p2 - p0);
+    return Eigen::Vector3d(cross(p1 - x, p2 - x), cross(p2 - x, p0 - x), cross(p0 - x, p1 - x)) / area2;
+  }
+
+  double c_at(Index t, const Vec2& x) const {
+    const Eigen::Vector3d l = barycentric(t, x);
+    return l[0] * c_[mesh_.triangles(t, 0)] + l[1] * c_[mesh_.triangles(t, 1)] + l[2] * c_[mesh_.triangles(t, 2)];
+  }
+
+  // Unit direction of the recovered flow at x, interpolated on triangle t.
+  Vec2 direction(Index t, const Vec2& x) const {
+    const Eigen::Vector3d l = barycentric(t, x);
+    const Vec2 u = l[0] * velocity_[mesh_.triangles(t, 0)] + l[1] * velocity_[mesh_.triangles(t, 1)] +
+                   l[2] * velocity_[mesh_.triangles(t, 2)];
+    const double norm = u.norm();
+    return norm > 0.0 ? Vec2(u / norm) : Vec2::Zero();
+  }
+
+  Index lowest_corner(Index t) const {
+    Index best = mesh_.triangles(t, 0);
+    for (int i = 1; i < 3; ++i) {
+      if (c_[mesh_.triangles(t, i)] < c_[best]) best = mesh_.triangles(t, i);
+    }
+    return best;
+  }
+
+  // The triangle at a vertex that the flow there points into, or -1.
+  Index enter(Index vertex) const {
+    const Vec2& g = velocity_[vertex];
+    if (g.squaredNorm() == 0.0) return -1;
+    for (Index k = offsets_[vertex]; k < offsets_[vertex + 1]; ++k) {
+      const Index t = incident_[k];
+      int j = 0;
+      while (mesh_.triangles(t, j) != vertex) ++j;
+      const Vec2 v = point(vertex);
+      const Vec2 ea = point(mesh_.triangles(t, (j + 1) % 3)) - v, eb = point(mesh_.triangles(t, (j + 2) % 3)) - v;
+      if (cross(ea, g) >= 0.0 && cross(g, eb) >= 0.0) return t;
+    }
+    return -1;
+  }
+
+  // No triangle at the vertex takes the flow: go down the steepest edge.
+  bool descend_edge(Index& vertex) const {
+    Index best = -1;
+    double steepest = 0.0;
+    for (Index k = offsets_[vertex]; k < offsets_[vertex + 1]; ++k) {
+      const Index t = incident_[k];
+      for (int i = 0; i < 3; ++i) {
+        const Index w = mesh_.triangles(t, i);
+        if (w == vertex) continue;
+        const double drop = (c_[vertex] - c_[w]) / (point(w) - point(vertex)).norm();
+        if (drop > steepest) steepest = drop, best = w;
+      }
+    }
+    if (best < 0) return false;
+    vertex = best;
+    return true;
+  }
+
+  const detail::RegionMesh& mesh_;
+  const Vector& c_;
+  const std::vector<char>& kind_;
+  std::vector<Vec2> velocity_;  // recovered -grad c at the vertices
+  std::vector<double> step_;    // RK4 step length in each triangle
+  std::vector<Index> offsets_, incident_;
+  Index step_limit_ = 0;
+};
+
+}  // namespace
+
+DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2Ref& target_points,
+                                  bool closed, const DiffusionOptions& options) {
+  const Index ns = detail::require_curve(source_points, closed, "c1");
+  const Index nt = detail::require_curve(target_points, closed, "c2");
+  if (!(options.mesh_size >= 0.0) || !std::isfinite(options.mesh_size)) {
+    detail::invalid("mesh_size", "must be a finite length >= 0");
+  }
+  if (!(options.mesh_fraction > 0.0) || !std::isfinite(options.mesh_fraction)) {
+    detail::invalid("mesh_fraction", "must be a finite number > 0");
+  }
+  const Points2 source = source_points.topRows(ns), target = target_points.topRows(nt);
+
+  // Boundary loops; input points are numbered source first, then target.
+  std::vector<Points2> loops;
+  std::vector<Index> target_row;  // input number of each target point
+  if (closed) {
+    if (curve_intersections(source, target, true).points.rows() == 0 &&
+        !inside(source.row(0).transpose(), target) && !inside(target.row(0).transpose(), source)) {
+      detail::invalid("c2", "diffusion mapping needs one curve inside the other, or crossing curves");
+    }
+    loops = {source, target};
+  } else {
+    // source forwards, then target backwards; shared end points (crossings) appear once.
+    const bool same_start = source.row(0) == target.row(0);
+    const bool same_end = source.row(ns - 1) == target.row(nt - 1);
+    const Index t_begin = same_start ? 1 : 0, t_end = same_end ? nt - 1 : nt;
+    Points2 loop(ns + (t_end - t_begin), 2);
+    loop.topRows(ns) = source;
+    for (Index i = t_end - 1, r = ns; i >= t_begin; --i, ++r) loop.row(r) = target.row(i);
+    loops = {loop};
+  }
+
+  double max_edge = options.mesh_size;
+  if (max_edge == 0.0) {
+    // Mean gap: twice the region's area over its boundary length; a first, coarse mesh tells the
+    // area when curves cross.
+    const detail::RegionMesh coarse = detail::mesh_region(loops, 0.0);
+    double area = 0.0;
+    for (Index t = 0; t < coarse.triangles.rows(); ++t) {
+      const Vec2 p0 = coarse.vertices.row(coarse.triangles(t, 0)).transpose();
+      area += 0.5 * cross(coarse.vertices.row(coarse.triangles(t, 1)).transpose() - p0,
+                          coarse.vertices.row(coarse.triangles(t, 2)).transpose() - p0);
+    }
+    const double boundary = perimeter(source, closed) + perimeter(target, closed);
+    max_edge = options.mesh_fraction * 2.0 * area / boundary;
+  }
+  const detail::RegionMesh mesh = detail::mesh_region(loops, max_edge);
+
+  // Dirichlet vertices: the input points, and the points the mesher added on the curves.
+  const Index nv = mesh.vertices.rows();
+  std::vector<char> kind(nv, free_vertex);
+  const CurveIndex on_source(source, closed), on_target(target, closed);
+  const double scale = (mesh.vertices.colwise().maxCoeff() - mesh.vertices.colwise().minCoeff()).norm();
+  for (Index v = 0; v < nv; ++v) {
+    const Index input = mesh.input[v];
+    if (input >= 0) {
+      kind[v] = input < ns ? source_vertex : target_vertex;
+      if (!closed && input < ns &&
+          ((input == 0 && source.row(0) == target.row(0)) ||
+           (input == ns - 1 && source.row(ns - 1) == target.row(nt - 1)))) {
+        kind[v] = target_vertex;  // a shared end point: already on the target
+      }
+    } else if (mesh.on_boundary[v]) {
+      const Points2 q = mesh.vertices.row(v);
+      const double ds = on_source.closest_points(q).distances[0];
+      const double dt = on_target.closest_points(q).distances[0];
+      const double tolerance = 1e-10 * scale;
+      if (dt <= tolerance) kind[v] = target_vertex;
+      else if (ds <= tolerance) kind[v] = source_vertex;
+    }
+  }
+
+  DiffusionSolution solution;
+  solution.potential = solve_potential(mesh, kind);
+  const Tracer tracer(mesh, solution.potential, kind);
+  solution.ends.resize(ns, 2);
+  if (options.keep_streamlines) solution.streamlines.resize(ns);
+  tbb::parallel_for(Index(0), ns, [&](Index i) {
+    std::vector<Vec2> path;
+    const Index start = mesh.of_input[i];
+    const Vec2 end = kind[start] == target_vertex ? mesh.vertices.row(start).transpose().eval()
+                                                  : tracer.trace(start, options.keep_streamlines ? &path : nullptr);
+    solution.ends.row(i) = end.transpose();
+    if (options.keep_streamlines) {
+      if (path.empty()) path.push_back(end);
+      Points2 line(path.size(), 2);
+      for (std::size_t k = 0; k < path.size(); ++k) line.row(k) = path[k].transpose();
+      solution.streamlines[i] = std::move(line);
+    }
+  });
+  solution.vertices = mesh.vertices;
+  solution.triangles = mesh.triangles;
+  return solution;
+}
+
+}  // namespace morphomap

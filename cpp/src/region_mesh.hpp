@@ -1,0 +1,28 @@
+#pragma once
+// Triangulation of a planar region bounded by closed loops (CGAL's constrained Delaunay mesher).
+#include <morphomap/types.hpp>
+
+#include <vector>
+
+namespace morphomap::detail {
+
+using Triangles = Eigen::Matrix<Index, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+struct RegionMesh {
+  Points2 vertices;
+  Triangles triangles;           // counter-clockwise
+  Triangles neighbours;          // neighbours(t, i): the triangle across the edge opposite
+                                 // vertex i of t, or -1 on the region's boundary
+  std::vector<Index> input;      // for each mesh vertex, its input point (loops concatenated), or -1
+  std::vector<Index> of_input;   // for each input point, its mesh vertex
+  std::vector<char> on_boundary; // mesh vertex on a constrained (boundary) edge
+};
+
+// The region is the set of points inside an odd number of the loops (an annulus for two nested
+// loops, each lobe of the symmetric difference for two crossing ones). Every input point is a
+// mesh vertex. Refinement: Ruppert's angle criterion (smallest angle about 20.7 degrees), which
+// grades the mesh from the point spacing on the loops and refines narrow gaps, and edges no
+// longer than max_edge (no bound when max_edge <= 0).
+RegionMesh mesh_region(const std::vector<Points2>& loops, double max_edge);
+
+}  // namespace morphomap::detail

@@ -1,0 +1,71 @@
+// Bindings of the 2D mapping: map_curves with its options, and the diffusion solution.
+#include <pybind11/eigen.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <morphomap/errors.hpp>
+#include <morphomap/laplace.hpp>
+#include <morphomap/mapping.hpp>
+
+namespace py = pybind11;
+using namespace morphomap;
+
+namespace {
+
+MapMethod map_method(const std::string& name) {
+  if (name == "minimal_distance") return MapMethod::minimal_distance;
+  if (name == "normal") return MapMethod::normal;
+  if (name == "diffusion") return MapMethod::diffusion;
+  if (name == "uniform") return MapMethod::uniform;
+  if (name == "auto") return MapMethod::automatic;
+  throw InvalidInput("method: expected 'auto', 'minimal_distance', 'normal', 'diffusion' or 'uniform', got '" + name + "'");
+}
+
+}  // namespace
+
+void bind_mapping(py::module_& m) {
+  m.def(
+      "map_curves",
+      [](const Points2Ref& c1, const Points2Ref& c2, const std::string& method, bool closed, Index n,
+         bool reverse, bool transform, bool split, std::optional<Vec2> anchor) {
+        CurveMappingOptions options;
+        options.method = map_method(method);
+        options.closed = closed;
+        options.n = n;
+        options.reverse = reverse;
+        options.transform = transform;
+        options.split = split;
+        options.anchor = anchor;
+        DisplacementField2 field;
+        {
+          py::gil_scoped_release release;
+          field = map_curves(c1, c2, options);
+        }
+        Eigen::Matrix<std::int8_t, Eigen::Dynamic, 1> codes(field.methods.size());
+        for (std::size_t i = 0; i < field.methods.size(); ++i) codes[i] = static_cast<std::int8_t>(field.methods[i]);
+        return py::make_tuple(std::move(field.starts), std::move(field.ends), std::move(codes));
+      },
+      py::arg("c1"), py::arg("c2"), py::arg("method"), py::arg("closed"), py::arg("n"),
+      py::arg("reverse"), py::arg("transform"), py::arg("split"), py::arg("anchor"));
+
+  m.def(
+      "solve_diffusion",
+      [](const Points2Ref& source, const Points2Ref& target, bool closed, double mesh_size,
+         double mesh_fraction, bool keep_streamlines) {
+        DiffusionOptions options;
+        options.mesh_size = mesh_size;
+        options.mesh_fraction = mesh_fraction;
+        options.keep_streamlines = keep_streamlines;
+        DiffusionSolution solution;
+        {
+          py::gil_scoped_release release;
+          solution = solve_diffusion(source, target, closed, options);
+        }
+        py::list streamlines;
+        for (Points2& line : solution.streamlines) streamlines.append(py::cast(std::move(line)));
+        return py::make_tuple(std::move(solution.vertices), std::move(solution.triangles),
+                              std::move(solution.potential), std::move(solution.ends), streamlines);
+      },
+      py::arg("source"), py::arg("target"), py::arg("closed"), py::arg("mesh_size"),
+      py::arg("mesh_fraction"), py::arg("keep_streamlines"));
+}

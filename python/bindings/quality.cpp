@@ -1,0 +1,24 @@
+// Bindings of the quality measures of a displacement field.
+#include <pybind11/eigen.h>
+#include <pybind11/pybind11.h>
+
+#include <morphomap/quality.hpp>
+
+namespace py = pybind11;
+using namespace morphomap;
+
+void bind_quality(py::module_& m) {
+  m.def(
+      "curve_quality",
+      [](const Points2Ref& starts, const Points2Ref& ends, const Points2Ref& c1,
+         const Points2Ref& c2, bool closed) {
+        CurveQuality q;
+        {
+          py::gil_scoped_release release;
+          DisplacementField2 field{starts, ends, {}};
+          q = quality(field, c1, c2, closed);
+        }
+        return py::make_tuple(q.qm1, q.qm2, q.qm, q.crossings);
+      },
+      py::arg("starts"), py::arg("ends"), py::arg("c1"), py::arg("c2"), py::arg("closed"));
+}

@@ -1,0 +1,64 @@
+"""The pieces of diffusion mapping: the region mesh, the potential and the streamlines."""
+
+from __future__ import annotations
+
+import numbers
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import _core
+from ._validate import as_flag, as_points
+
+
+@dataclass(frozen=True)
+class DiffusionSolution:
+    """The Laplace problem between two curves, solved.
+
+    vertices : (V, 2) float and triangles : (T, 3) int64
+        The region mesh (counter-clockwise triangles); every point of both curves is a vertex.
+    potential : (V,) float
+        c at the vertices: P1 finite elements with c = 1 on C1 and c = 0 on C2.
+    ends : (N, 2) float
+        Where the streamline of -grad c from each point of C1 meets C2 (NaN if it does not).
+    streamlines : list of (K, 2) float
+        With ``streamlines=True``: the polyline of each streamline, from C1 to C2.
+    """
+
+    vertices: np.ndarray
+    triangles: np.ndarray
+    potential: np.ndarray
+    ends: np.ndarray
+    streamlines: list
+
+
+def _length(value, name, default):
+    if value is None:
+        return default
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name}: expected a number, got {type(value).__name__}")
+    value = float(value)
+    if not np.isfinite(value) or value <= 0:
+        raise ValueError(f"{name}: must be a finite number > 0, got {value}")
+    return value
+
+
+def solve_diffusion(c1, c2, *, closed=True, mesh_size=None, mesh_fraction=0.02, streamlines=False):
+    """Solve Laplace's equation between C1 (c = 1) and C2 (c = 0) and trace the streamlines.
+
+    The region: closed curves nested (an annulus) or crossing (each lobe of the symmetric
+    difference); open curves joined start to start and end to end by straight edges without flux.
+    The mesh is CGAL's constrained Delaunay mesh with both curves as constraints, graded from their
+    point spacing, with edges no longer than ``mesh_size`` (default: ``mesh_fraction`` times the
+    mean gap, twice the region's area over its boundary length). The gradient of the P1 solution
+    is constant on each triangle, so streamlines are followed exactly from edge to edge.
+
+    Returns
+    -------
+    DiffusionSolution
+    """
+    vertices, triangles, potential, ends, lines = _core.solve_diffusion(
+        as_points(c1, "c1"), as_points(c2, "c2"), as_flag(closed, "closed"),
+        _length(mesh_size, "mesh_size", 0.0), _length(mesh_fraction, "mesh_fraction", 0.02),
+        as_flag(streamlines, "streamlines"))
+    return DiffusionSolution(vertices, triangles, potential, ends, list(lines))

@@ -1,0 +1,64 @@
+"""Displacement fields between two curves (2D): the paper's algorithms and extensions."""
+
+from __future__ import annotations
+
+from . import _core
+from ._validate import as_choice, as_count, as_flag, as_point, as_points
+from .field import DisplacementField
+
+CURVE_METHODS = ("auto", "minimal_distance", "normal", "diffusion", "uniform")
+
+
+def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, transform=False,
+               split=True, anchor=None) -> DisplacementField:
+    """Map curve ``c1`` (time t) onto curve ``c2`` (time t + dt).
+
+    Parameters
+    ----------
+    c1, c2 : (N, 2) float
+        The curves, both closed unless ``closed=False`` (open curves are expected to run the same
+        way: start maps towards start).
+    method : {"auto", "minimal_distance", "normal", "diffusion", "uniform"}
+        ``"minimal_distance"``: each start point to its closest point on C2.
+        ``"normal"``: the line through each start point along its normal, both directions, to its
+        nearest intersection with C2; NaN where it meets nothing.
+        ``"uniform"``: the arc-length fraction of each start point from an anchor on C1 to the
+        same fraction from the corresponding anchor on C2. Anchors: the ends of open curves; an
+        intersection point of closed curves; else ``anchor``; else the cyclic shift of C2 that
+        minimises the sum of squared displacements of equally spaced points.
+        ``"diffusion"``: streamlines of Laplace's equation between the curves (c = 1 on C1, 0 on C2;
+        see :func:`solve_diffusion`) from each start point to C2.
+        ``"auto"`` (the default; the paper's Algorithm 1): split at intersections, normal mapping
+        on each pair of segments, and reverse diffusion for a pair where normal mapping gives
+        crossings or misses. ``field.method`` tells which algorithm made each vector.
+    n : int, optional
+        Resample both curves to ``n`` equally spaced points first (linear, the paper's
+        preprocessing); by default the given points of the source curve are the start points.
+    reverse : bool
+        Map C2 -> C1 with the chosen algorithm and flip the vectors: starts lie on C1, ends on
+        C2, in the order of C2's points.
+    transform : bool
+        Appendix A: scale C1 about its centroid to the area of C2 and align it rigidly to maximise
+        the overlap (open curves: the similarity that takes C1's ends onto C2's), map, then carry
+        the start points back onto the original C1.
+    split : bool
+        Where the curves cross, split both at the intersection points and map each pair of
+        segments on its own; the intersection points are inserted as start points that map onto
+        themselves. No effect when they do not cross.
+    anchor : (2,) float, optional
+        Uniform mapping of closed curves that do not cross: the point of C1 nearest to ``anchor``
+        maps onto the point of C2 nearest to it.
+
+    Returns
+    -------
+    DisplacementField
+    """
+    closed = as_flag(closed, "closed")
+    method = as_choice(method, "method", CURVE_METHODS)
+    count = 0 if n is None else as_count(n, "n", 3 if closed else 2)
+    if anchor is not None:
+        anchor = as_point(anchor, "anchor")
+    starts, ends, codes = _core.map_curves(
+        as_points(c1, "c1"), as_points(c2, "c2"), method, closed, count,
+        as_flag(reverse, "reverse"), as_flag(transform, "transform"), as_flag(split, "split"), anchor)
+    return DisplacementField._from_core(starts, ends, codes)

@@ -1,0 +1,111 @@
+"""Pictures of displacement fields in the style of the paper's figures (needs matplotlib)."""
+
+from __future__ import annotations
+
+import os
+import sys
+
+import numpy as np
+
+from ._validate import as_flag, as_points
+from .crossings import crossing_pairs
+from .field import DisplacementField
+
+C1_COLOUR = "tab:green"
+C2_COLOUR = "tab:blue"
+VECTOR_COLOUR = "red"
+CROSSING_COLOUR = "darkorange"
+MISS_COLOUR = "grey"
+
+
+def _headless() -> bool:
+    """True when no backend was chosen and there is no display to show windows on."""
+    if os.environ.get("MPLBACKEND") or "matplotlib.pyplot" in sys.modules:
+        return False
+    if sys.platform.startswith(("win", "darwin")):
+        return False
+    return not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+
+
+def _new_axes():
+    import matplotlib
+
+    if _headless():
+        matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    _, ax = plt.subplots(figsize=(6, 6))
+    return ax
+
+
+def _closed_line(points, closed):
+    return np.vstack([points, points[:1]]) if closed and len(points) else points
+
+
+def plot_field(field, c1, c2, ax=None, *, closed=True, title=None):
+    """Draw a 2D displacement field between two curves; returns the matplotlib ``Axes``.
+
+    C1 is drawn in green, C2 in blue, the vectors as thin red lines with a small dot at each end
+    point (as in the paper's figures). Vectors that cross another vector
+    (:func:`morphomap.crossing_pairs`) are drawn thicker in orange; start points without a target
+    (invalid rows; where the start is NaN but the end is not, the end point on C2) are marked
+    with a grey ``x``; rows that are NaN at both ends are counted in the legend but cannot be placed.
+    Equal aspect, a legend naming the counts.
+
+    Parameters
+    ----------
+    field : DisplacementField
+        A 2D field.
+    c1, c2 : (N, 2) float
+        The curves the field maps between.
+    ax : matplotlib.axes.Axes, optional
+        Where to draw; by default a new figure (with matplotlib's Agg backend when there is no
+        display and no backend was chosen). Nothing is shown: save it with ``ax.figure.savefig``.
+    closed : bool
+        Draw the curves closed.
+    title : str, optional
+
+    Artists added: two lines (C1, C2) and two collections (the vectors, their end points), plus one
+    collection for crossing vectors and one for misses when there are any.
+    """
+    if not isinstance(field, DisplacementField):
+        raise TypeError(f"field: expected a DisplacementField, got {type(field).__name__}")
+    if field.dim != 2:
+        raise ValueError(f"field: expected a 2D field, got {field.dim}D")
+    c1 = as_points(c1, "c1")
+    c2 = as_points(c2, "c2")
+    closed = as_flag(closed, "closed")
+    if title is not None and not isinstance(title, str):
+        raise TypeError(f"title: expected a string, got {type(title).__name__}")
+    from matplotlib.collections import LineCollection
+
+    if ax is None:
+        ax = _new_axes()
+
+    starts, ends, valid = field.starts, field.ends, field.valid
+    pairs = crossing_pairs(starts, ends)
+    crossing = np.zeros(len(field), dtype=bool)
+    crossing[pairs.ravel()] = True
+    plain = valid & ~crossing
+    segments = np.stack([starts, ends], axis=1)
+
+    ax.plot(*_closed_line(c1, closed).T, color=C1_COLOUR, lw=1.6, label="$C_1$", zorder=2)
+    ax.plot(*_closed_line(c2, closed).T, color=C2_COLOUR, lw=1.6, label="$C_2$", zorder=2)
+    ax.add_collection(LineCollection(segments[plain], colors=VECTOR_COLOUR, linewidths=0.7, zorder=3,
+                                     label=f"vectors ({int(valid.sum())})"))
+    ax.scatter(*ends[valid].reshape(-1, 2).T, s=4, color=VECTOR_COLOUR, zorder=4, linewidths=0)
+    if crossing.any():
+        ax.add_collection(LineCollection(segments[crossing], colors=CROSSING_COLOUR, linewidths=1.6, zorder=5,
+                                         label=f"crossing ({len(pairs)} pairs)"))
+    missed = ~valid
+    if missed.any():
+        marks = np.where(np.isfinite(starts[missed]).all(axis=1, keepdims=True), starts[missed], ends[missed])
+        marks = marks[np.isfinite(marks).all(axis=1)]
+        ax.scatter(*marks.reshape(-1, 2).T, marker="x", s=22, color=MISS_COLOUR, linewidths=1.0, zorder=6,
+                   label=f"no target ({int(missed.sum())})")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.autoscale_view()
+    ax.legend(loc="best", fontsize="small", framealpha=0.8)
+    if title is not None:
+        ax.set_title(title)
+    return ax

@@ -1,0 +1,134 @@
+"""Curve and field CSV files, and the bundled example curves."""
+
+import math
+
+import numpy as np
+import pytest
+
+import morphomap as mm
+from conftest import circle
+from morphomap.io import EXAMPLES
+
+
+def test_curve_round_trip_is_exact(tmp_path, rng):
+    points = rng.normal(size=(57, 2)) * 10.0 ** rng.integers(-12, 12, size=(57, 1))
+    mm.write_curve(tmp_path / "c.csv", points)
+    assert (tmp_path / "c.csv").read_text().splitlines()[0] == "x,y"
+    assert np.array_equal(mm.read_curve(tmp_path / "c.csv"), points)
+    mm.write_curve(tmp_path / "bare.csv", points, header=False)
+    assert np.array_equal(mm.read_curve(str(tmp_path / "bare.csv")), points)
+
+
+def test_curve_formats_read(tmp_path):
+    (tmp_path / "named.csv").write_text("# made by hand\nid, Y ,X\n0, 2.5, 1\n\n1, -3e-1, 4\n")
+    assert np.array_equal(mm.read_curve(tmp_path / "named.csv"), [[1, 2.5], [4, -0.3]])
+    (tmp_path / "spaces.txt").write_text("1 2\n3\t4\n5 6\n")
+    assert np.array_equal(mm.read_curve(tmp_path / "spaces.txt"), [[1, 2], [3, 4], [5, 6]])
+    (tmp_path / "any_header.csv").write_text("\ufeffu,v\n1,2\n")  # a byte-order mark, other names
+    assert np.array_equal(mm.read_curve(tmp_path / "any_header.csv"), [[1, 2]])
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("", "no points"),
+        ("x,y\n", "no points after the header"),
+        ("1,2,3\n4,5,6\n", "line 1: expected 2 values"),
+        ("x,y\n1,2\n3\n", "line 3: expected 2 values like the header"),
+        ("x,y\n1,2\n3,abc\n", "line 3, column y: 'abc' is not a number"),
+        ("1,2\n3,nan\n", "line 2, column y: 'nan' is not a finite number"),
+        ("a,b,c\n1,2,3\n", "expected a header with columns x and y"),
+    ],
+)
+def test_bad_curve_files_are_named(tmp_path, text, message):
+    path = tmp_path / "bad.csv"
+    path.write_text(text)
+    with pytest.raises(ValueError, match=message) as error:
+        mm.read_curve(path)
+    assert "bad.csv" in str(error.value)
+
+
+def test_missing_and_binary_curve_files(tmp_path):
+    with pytest.raises(FileNotFoundError):
+        mm.read_curve(tmp_path / "nothing.csv")
+    (tmp_path / "binary.csv").write_bytes(b"\xff\xfe\x00\x81\x9f")
+    with pytest.raises(ValueError, match="not a text"):
+        mm.read_curve(tmp_path / "binary.csv")
+
+
+def test_field_round_trip_with_nan_rows(tmp_path):
+    starts = circle(6)
+    ends = 2 * starts
+    ends[[1, 4]] = np.nan
+    methods = ["normal", "normal", "diffusion", "normal", "minimal_distance", "uniform"]
+    field = mm.DisplacementField(starts, ends, methods)
+    mm.write_field(tmp_path / "f.csv", field)
+    lines = (tmp_path / "f.csv").read_text().splitlines()
+    assert lines[0] == "start_x,start_y,end_x,end_y,valid,method"
+    assert lines[2].endswith(",nan,nan,0,normal")
+    back = mm.read_field(tmp_path / "f.csv")
+    assert np.array_equal(back.starts, field.starts)
+    assert np.array_equal(back.ends, field.ends, equal_nan=True)
+    assert np.array_equal(back.valid, field.valid) and list(back.method) == methods
+
+
+def test_field_of_a_mapping_round_trips(tmp_path):
+    c1, c2 = mm.load_example("circle_ellipse")
+    field = mm.map_curves(c1, c2, "normal", reverse=True)
+    mm.write_field(tmp_path / "f.csv", field)
+    back = mm.read_field(tmp_path / "f.csv")
+    assert np.array_equal(back.starts, field.starts, equal_nan=True)
+    assert np.array_equal(back.ends, field.ends, equal_nan=True)
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("start_x,start_y,end_x,end_y,valid\n", r"lacks the column\(s\) method"),
+        ("start_x,start_y,end_x,end_y,valid,method\n0,0,1,1,1\n", "line 2: expected 6 values"),
+        ("start_x,start_y,end_x,end_y,valid,method\n0,0,1,nan,1,normal\n", "valid is 1 but"),
+        ("start_x,start_y,end_x,end_y,valid,method\n0,0,1,1,yes,normal\n", "column valid"),
+        ("start_x,start_y,end_x,end_y,valid,method\n0,0,1,1,1,closest\n", "unknown algorithm names"),
+    ],
+)
+def test_bad_field_files_are_named(tmp_path, text, message):
+    (tmp_path / "bad.csv").write_text(text)
+    with pytest.raises(ValueError, match=message):
+        mm.read_field(tmp_path / "bad.csv")
+
+
+def test_write_to_an_open_file(tmp_path):
+    with open(tmp_path / "c.csv", "w") as handle:
+        mm.write_curve(handle, [[0, 0], [1, 0.5]])
+        assert not handle.closed
+    assert (tmp_path / "c.csv").read_text() == "x,y\n0.0,0.0\n1.0,0.5\n"
+    with pytest.raises(TypeError, match="field: expected a DisplacementField"):
+        mm.write_field(tmp_path / "f.csv", np.zeros((3, 4)))
+
+
+def test_bundled_examples():
+    assert set(EXAMPLES) == {"circle_ellipse", "kidney"}
+    for name in EXAMPLES:
+        c1, c2 = mm.load_example(name)
+        for curve in (c1, c2):
+            assert not mm.is_self_intersecting(curve)
+            assert mm.orientation(curve) == 1
+    c1, c2 = mm.load_example("circle_ellipse")
+    assert c1.shape == c2.shape == (100, 2)
+    assert np.allclose(np.hypot(*c1.T), 0.95, rtol=0, atol=1e-15)
+    assert np.allclose(c1[0], [0.95, 0]) and np.allclose(c2[0], [2.177, 0])
+    assert np.allclose(np.hypot(c2[:, 0] / 2.177, c2[:, 1]), 1.0, atol=1e-5)
+    steps = np.hypot(*(np.roll(c2, -1, axis=0) - c2).T)
+    assert steps.max() / steps.min() < 1.01  # equal arcs, so nearly equal chords
+    k1, k2 = mm.load_example("kidney")
+    assert 300 <= len(k1) <= 600 and 300 <= len(k2) <= 600
+    assert len(mm.curve_intersections(k1, k2)) >= 2
+    with pytest.raises(ValueError, match="name: expected one of"):
+        mm.load_example("lung")
+
+
+def test_kidney_example_defeats_plain_normal_mapping():
+    c1, c2 = mm.load_example("kidney")
+    field = mm.map_curves(c1, c2, "normal", split=True)
+    assert mm.count_crossings(field.starts, field.ends) > 0
+    assert math.isfinite(mm.quality(field, c1, c2).qm)
