@@ -319,7 +319,7 @@ def check(kernel: str, name: str, reference: np.ndarray, result: np.ndarray) -> 
 
     closest_points: equal distances to 1e-9 (double precision peers), cKDTree only a bound.
     line_intersections: equal hit distances to 1e-4 relative (float32 peers); a line that grazes
-    the curve may hit or miss in float32 alone, so up to 1e-4 of the lines may disagree.
+    the curve may hit or miss in float32 alone, so up to 1e-4 of the lines (at least 5) may disagree.
     """
     if kernel == "closest_points":
         if name == "cKDTree-vertex":
@@ -331,7 +331,7 @@ def check(kernel: str, name: str, reference: np.ndarray, result: np.ndarray) -> 
     both_miss = np.isinf(reference) & np.isinf(result)
     close = np.isclose(result, reference, rtol=1e-4, atol=1e-6) | both_miss
     bad = int(np.count_nonzero(~close))
-    assert bad <= max(1, 1e-4 * len(reference)), (
+    assert bad <= max(5, 1e-4 * len(reference)), (
         f"{name}: {bad} of {len(reference)} line hits differ by more than 1e-4 relative"
     )
     finite = np.isfinite(reference) & np.isfinite(result) & close

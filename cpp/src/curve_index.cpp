@@ -34,9 +34,14 @@ struct Box {
   }
 };
 
+// A box as centre and half extents: the form the query tests need.
+struct CentredBox {
+  double cx, cy, hx, hy;
+};
+
 // Inner nodes keep their left child right after themselves, so only the right one is stored.
 struct Node {
-  Box box;
+  CentredBox box;
   std::int32_t first;  // leaf: first slot in the segment arrays; inner: index of the right child
   std::int32_t count;  // leaf: number of segments; inner: 0
 };
@@ -49,20 +54,23 @@ struct Segment {
   std::int64_t id;   // index in the curve: from point id to point id + 1
 };
 
-double box_distance2(const Box& b, double x, double y) {
-  const double dx = std::max({b.lo[0] - x, 0.0, x - b.hi[0]});
-  const double dy = std::max({b.lo[1] - y, 0.0, y - b.hi[1]});
+double box_distance2(const CentredBox& b, double x, double y) {
+  const double dx = std::max(std::abs(x - b.cx) - b.hx, 0.0);
+  const double dy = std::max(std::abs(y - b.cy) - b.hy, 0.0);
   return dx * dx + dy * dy;
 }
 
-// Smallest |t| of a point of the box on the line o + t u, or +inf when the line misses the box.
-double box_line_bound(const Box& b, double ox, double oy, double ux, double uy) {
-  const double cx = 0.5 * (b.lo[0] + b.hi[0]) - ox, cy = 0.5 * (b.lo[1] + b.hi[1]) - oy;
-  const double hx = 0.5 * (b.hi[0] - b.lo[0]), hy = 0.5 * (b.hi[1] - b.lo[1]);
-  const double across = std::abs(ux * cy - uy * cx);  // distance of the centre from the line
-  const double ax = std::abs(ux), ay = std::abs(uy);
-  if (across > ay * hx + ax * hy) return kInf;
-  const double along = ux * cx + uy * cy, reach = ax * hx + ay * hy;
+// A line o + t u with |u| = 1, and |u|'s components for the box tests.
+struct Line {
+  double ox, oy, ux, uy, ax, ay;
+};
+
+// Smallest |t| of a point of the box on the line, or +inf when the line misses the box.
+double box_line_bound(const CentredBox& b, const Line& l) {
+  const double cx = b.cx - l.ox, cy = b.cy - l.oy;
+  const double across = std::abs(l.ux * cy - l.uy * cx);  // distance of the centre from the line
+  if (across > l.ay * b.hx + l.ax * b.hy) return kInf;
+  const double along = l.ux * cx + l.uy * cy, reach = l.ax * b.hx + l.ay * b.hy;
   return std::max(std::abs(along) - reach, 0.0);
 }
 
@@ -121,7 +129,8 @@ struct CurveIndex::Impl {
       box.grow(s.ax + s.ex, s.ay + s.ey);
       centres.grow(s.ax + 0.5 * s.ex, s.ay + 0.5 * s.ey);
     }
-    nodes[index].box = box;
+    nodes[index].box = {0.5 * (box.lo[0] + box.hi[0]), 0.5 * (box.lo[1] + box.hi[1]),
+                         0.5 * (box.hi[0] - box.lo[0]), 0.5 * (box.hi[1] - box.lo[1])};
     if (end - begin <= kLeafSize) {
       nodes[index].first = begin;
       nodes[index].count = end - begin;
@@ -183,25 +192,25 @@ struct CurveIndex::Impl {
     return best;
   }
 
-  Hit line(double ox, double oy, double ux, double uy) const {
+  Hit line(const Line& l) const {
     Hit best;
     std::int32_t stack[kStackSize];
     double bound[kStackSize];
     int top = 0;
     std::int32_t node = 0;
-    double node_bound = box_line_bound(nodes[0].box, ox, oy, ux, uy);
-    auto beaten = [&best](double b) { return best.segment && b > std::abs(best.distance); };
+    double node_bound = box_line_bound(nodes[0].box, l);
+    auto beaten = [&best](double b) { return b == kInf || (best.segment && b > std::abs(best.distance)); };
     for (;;) {
-      if (node_bound != kInf && !beaten(node_bound)) {
+      if (!beaten(node_bound)) {
         const Node& nd = nodes[node];
         if (nd.count > 0) {
-          for (std::int32_t k = nd.first; k < nd.first + nd.count; ++k) visit(segments[k], ox, oy, ux, uy, best);
+          for (std::int32_t k = nd.first; k < nd.first + nd.count; ++k) visit(segments[k], l, best);
         } else {
           std::int32_t near = node + 1, far = nd.first;
-          double near_b = box_line_bound(nodes[near].box, ox, oy, ux, uy);
-          double far_b = box_line_bound(nodes[far].box, ox, oy, ux, uy);
+          double near_b = box_line_bound(nodes[near].box, l);
+          double far_b = box_line_bound(nodes[far].box, l);
           if (far_b < near_b) std::swap(near, far), std::swap(near_b, far_b);
-          if (far_b != kInf) stack[top] = far, bound[top++] = far_b;
+          if (!beaten(far_b)) stack[top] = far, bound[top++] = far_b;
           node = near, node_bound = near_b;
           continue;
         }
@@ -213,13 +222,16 @@ struct CurveIndex::Impl {
     return best;
   }
 
-  // Intersection of the line o + t u with one segment; keeps it when it beats the best so far.
-  static void visit(const Segment& s, double ox, double oy, double ux, double uy, Hit& best) {
-    const double wx = s.ax - ox, wy = s.ay - oy;
+  // Intersection of the line with one segment; keeps it when it beats the best so far. The
+  // crossing test needs no division: only an accepted hit divides.
+  static void visit(const Segment& s, const Line& l, Hit& best) {
+    const double wx = s.ax - l.ox, wy = s.ay - l.oy;
+    const double ux = l.ux, uy = l.uy;
     const double denom = ux * s.ey - uy * s.ex;
     if (denom != 0.0) {
-      const double sp = (wx * uy - wy * ux) / denom;
-      if (!(sp >= 0.0 && sp <= 1.0)) return;
+      const double along = wx * uy - wy * ux;  // sp * denom
+      if (denom > 0.0 ? (along < 0.0 || along > denom) : (along > 0.0 || along < denom)) return;
+      const double sp = along / denom;
       const double t = (wx * s.ey - wy * s.ex) / denom;
       if (line_hit_before(t, s.id, best)) {
         best.x = s.ax + sp * s.ex, best.y = s.ay + sp * s.ey;
@@ -303,8 +315,9 @@ CurveHits CurveIndex::line_intersections(const Points2Ref& origins,
                     [&](const tbb::blocked_range<Index>& range) {
                       for (Index i = range.begin(); i < range.end(); ++i) {
                         const double dx = directions(i, 0), dy = directions(i, 1);
-                        const double norm = std::hypot(dx, dy);
-                        store(hits, i, impl_->line(origins(i, 0), origins(i, 1), dx / norm, dy / norm));
+                        const double norm = std::sqrt(dx * dx + dy * dy);
+                        const double ux = dx / norm, uy = dy / norm;
+                        store(hits, i, impl_->line({origins(i, 0), origins(i, 1), ux, uy, std::abs(ux), std::abs(uy)}));
                       }
                     });
   return hits;

@@ -11,6 +11,7 @@
 #include <Eigen/SparseCore>
 #include <tbb/parallel_for.h>
 
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -315,6 +316,12 @@ DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2
     loops = {loop};
   }
 
+  using Clock = std::chrono::steady_clock;
+  auto seconds_since = [](Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+  };
+  DiffusionSolution solution;
+  auto clock = Clock::now();
   double max_edge = options.mesh_size;
   if (max_edge == 0.0) {
     // Mean gap: twice the region's area over its boundary length; a first, coarse mesh tells the
@@ -330,6 +337,8 @@ DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2
     max_edge = options.mesh_fraction * 2.0 * area / boundary;
   }
   const detail::RegionMesh mesh = detail::mesh_region(loops, max_edge);
+  solution.mesh_seconds = seconds_since(clock);
+  clock = Clock::now();
 
   // Dirichlet vertices: the input points, and the points the mesher added on the curves.
   const Index nv = mesh.vertices.rows();
@@ -355,8 +364,9 @@ DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2
     }
   }
 
-  DiffusionSolution solution;
   solution.potential = solve_potential(mesh, kind);
+  solution.solve_seconds = seconds_since(clock);
+  clock = Clock::now();
   const Tracer tracer(mesh, solution.potential, kind);
   solution.ends.resize(ns, 2);
   if (options.keep_streamlines) solution.streamlines.resize(ns);
@@ -373,6 +383,7 @@ DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2
       solution.streamlines[i] = std::move(line);
     }
   });
+  solution.trace_seconds = seconds_since(clock);
   solution.vertices = mesh.vertices;
   solution.triangles = mesh.triangles;
   return solution;

@@ -143,7 +143,8 @@ bool first_piece_inside(const Points2& curve, const Vector& arc, const Cuts& c,
       on_cut = c.arc[r] <= arc(i) || c.points[r] == curve.row(i).transpose();
     }
     if (on_cut || c.points[at > 0 ? at - 1 : k - 1] == curve.row(i).transpose()) continue;
-    const bool in = inside_shifted(other, curve.row(i).transpose(), curve.row((i + 1) % n).transpose(), s);
+    const bool in =
+        inside_shifted(other, curve.row(i).transpose(), curve.row((i + 1) % n).transpose(), s);
     // Vertex i lies on the piece that starts at cut before - 1 (the last piece, wrapping, when
     // before == 0).
     const Index piece = (before + k - 1) % k;
@@ -223,14 +224,21 @@ double overlap_area(const Points2Ref& a, const Points2Ref& b) {
   if (x.points.rows() == 0) {
     // No crossing: one contains the other, or they are apart. The second curve is shifted by
     // ε(1, δ), so a vertex of a is tested shifted by -ε(1, δ), one of b by +ε(1, δ).
-    if (inside_shifted(pb, pa.row(0).transpose(), pa.row(1).transpose(), -1)) return 0.5 * twice_area(pa, origin);
-    if (inside_shifted(pa, pb.row(0).transpose(), pb.row(1).transpose(), +1)) return 0.5 * twice_area(pb, origin);
+    if (inside_shifted(pb, pa.row(0).transpose(), pa.row(1).transpose(), -1)) {
+      return 0.5 * twice_area(pa, origin);
+    }
+    if (inside_shifted(pa, pb.row(0).transpose(), pb.row(1).transpose(), +1)) {
+      return 0.5 * twice_area(pb, origin);
+    }
     return 0.0;
   }
+  // Two closed curves cross an even number of times under the shift.
+  if (x.points.rows() % 2 != 0) throw GeometryError("overlap_area: an odd number of crossings");
   const Cuts ca = cuts_along(x, true), cb = cuts_along(x, false);
   const bool a_first = first_piece_inside(pa, arc_positions(pa), ca, pb, -1);
   const bool b_first = first_piece_inside(pb, arc_positions(pb), cb, pa, +1);
-  const double twice = inside_pieces(pa, ca, a_first, origin) + inside_pieces(pb, cb, b_first, origin);
+  const double twice =
+      inside_pieces(pa, ca, a_first, origin) + inside_pieces(pb, cb, b_first, origin);
   return std::max(0.0, 0.5 * twice);
 }
 

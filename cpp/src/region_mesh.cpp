@@ -9,6 +9,9 @@
 #include <CGAL/Delaunay_mesher_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
+#include <CGAL/property_map.h>
+#include <CGAL/spatial_sort.h>
+#include <CGAL/Spatial_sort_traits_adapter_2.h>
 
 #include <queue>
 #include <unordered_map>
@@ -68,21 +71,33 @@ void mark_odd_nesting(Cdt& cdt) {
 
 RegionMesh mesh_region(const std::vector<Points2>& loops, double max_edge) {
   Cdt cdt;
-  std::vector<Cdt::Vertex_handle> handles;
-  Index input = 0;
+  std::vector<Point> points;
+  for (const Points2& loop : loops) {
+    for (Index i = 0; i < loop.rows(); ++i) points.emplace_back(loop(i, 0), loop(i, 1));
+  }
+  // Inserting points in their order along a curve (nearly co-circular) costs many flips per point:
+  // insert them in spatial (Hilbert) order, each near the last.
+  std::vector<std::size_t> order(points.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  using SortTraits = CGAL::Spatial_sort_traits_adapter_2<Kernel, CGAL::Pointer_property_map<Point>::type>;
+  CGAL::spatial_sort(order.begin(), order.end(), SortTraits(CGAL::make_property_map(points)));
+  std::vector<Cdt::Vertex_handle> handles(points.size());
   try {
+    Cdt::Face_handle hint;
+    for (const std::size_t i : order) {
+      const auto v = cdt.insert(points[i], hint);
+      if (v->info().input < 0 || static_cast<Index>(i) < v->info().input) v->info().input = static_cast<Index>(i);
+      handles[i] = v;
+      hint = v->face();
+    }
+    Index first = 0;
     for (const Points2& loop : loops) {
-      const Index first = static_cast<Index>(handles.size());
-      for (Index i = 0; i < loop.rows(); ++i, ++input) {
-        const auto v = cdt.insert(Point(loop(i, 0), loop(i, 1)));
-        if (v->info().input < 0) v->info().input = input;
-        handles.push_back(v);
-      }
       const Index n = loop.rows();
       for (Index i = 0; i < n; ++i) {
         const auto a = handles[first + i], b = handles[first + (i + 1) % n];
         if (a != b) cdt.insert_constraint(a, b);
       }
+      first += n;
     }
     mark_odd_nesting(cdt);
     CGAL::refine_Delaunay_mesh_2(cdt, Criteria(0.125, max_edge > 0 ? max_edge : 0.0), true);

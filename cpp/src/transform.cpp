@@ -38,7 +38,8 @@ Points2 checked_closed(const Points2Ref& points, const char* name) {
     detail::invalid(name, "the closed curve encloses zero area");
   }
   if (is_self_intersecting(q, true)) {
-    detail::invalid(name, "the closed curve intersects itself; the overlap area needs a simple curve");
+    detail::invalid(name,
+                    "the closed curve intersects itself; the overlap area needs a simple curve");
   }
   return q;
 }
@@ -160,7 +161,8 @@ Points2 Similarity2::apply_inverse(const Points2Ref& points) const {
   return out;
 }
 
-Similarity2 align_curves(const Points2Ref& c1, const Points2Ref& c2, bool closed, double tolerance) {
+Similarity2 align_curves(const Points2Ref& c1, const Points2Ref& c2, bool closed,
+                         double tolerance) {
   if (!(std::isfinite(tolerance) && tolerance > 0)) {
     detail::invalid("tolerance", "must be positive and finite, got " + std::to_string(tolerance));
   }

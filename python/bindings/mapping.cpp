@@ -63,8 +63,13 @@ void bind_mapping(py::module_& m) {
         }
         py::list streamlines;
         for (Points2& line : solution.streamlines) streamlines.append(py::cast(std::move(line)));
+        py::dict seconds;
+        seconds["mesh"] = solution.mesh_seconds;
+        seconds["solve"] = solution.solve_seconds;
+        seconds["trace"] = solution.trace_seconds;
         return py::make_tuple(std::move(solution.vertices), std::move(solution.triangles),
-                              std::move(solution.potential), std::move(solution.ends), streamlines);
+                              std::move(solution.potential), std::move(solution.ends), streamlines,
+                              seconds);
       },
       py::arg("source"), py::arg("target"), py::arg("closed"), py::arg("mesh_size"),
       py::arg("mesh_fraction"), py::arg("keep_streamlines"));

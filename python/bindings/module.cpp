@@ -12,6 +12,8 @@ void bind_curves(py::module_& m);
 void bind_mapping(py::module_& m);
 void bind_transform(py::module_& m);
 void bind_quality(py::module_& m);
+void bind_surfaces(py::module_& m);
+void bind_diffusion3d(py::module_& m);
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "morphomap C++ core (use the morphomap package, not this module)";
@@ -33,4 +35,6 @@ PYBIND11_MODULE(_core, m) {
   bind_mapping(m);
   bind_transform(m);
   bind_quality(m);
+  bind_surfaces(m);
+  bind_diffusion3d(m);
 }

@@ -19,12 +19,14 @@ from .curves import (
     signed_area,
 )
 from .diffusion import DiffusionSolution, solve_diffusion
+from .diffusion3d import ShellDiffusionSolution, solve_diffusion_3d
 from .field import DisplacementField
 from .io import load_example, read_curve, read_field, write_curve, write_field
 from .mapping import map_curves
 from .plot import plot_field
-from .quality import CurveQuality, quality
+from .quality import CurveQuality, SurfaceQuality, quality
 from .queries import CurveHits, CurveIndex, closest_points, line_intersections
+from .surfaces import SurfaceHits, SurfaceIndex, map_surfaces, surface_normals
 from .transform import Similarity, align_curves, overlap_area
 
 __version__ = _build_info()["version"]
@@ -44,6 +46,10 @@ __all__ = [
     "GeometryError",
     "InvalidInput",
     "Similarity",
+    "ShellDiffusionSolution",
+    "SurfaceHits",
+    "SurfaceIndex",
+    "SurfaceQuality",
     "align_curves",
     "arc_lengths",
     "build_info",
@@ -55,6 +61,7 @@ __all__ = [
     "line_intersections",
     "load_example",
     "map_curves",
+    "map_surfaces",
     "normals",
     "orientation",
     "overlap_area",
@@ -65,7 +72,9 @@ __all__ = [
     "read_field",
     "resample",
     "signed_area",
+    "surface_normals",
     "write_curve",
     "write_field",
     "solve_diffusion",
+    "solve_diffusion_3d",
 ]

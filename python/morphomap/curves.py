@@ -80,9 +80,13 @@ def is_self_intersecting(points, *, closed=True) -> bool:
 def curve_intersections(c1, c2, *, closed=True, return_arc_lengths=False):
     """Points where ``c2`` crosses ``c1``, in order along ``c1``.
 
-    Crossings are decided with exact predicates; a contact where ``c2`` touches ``c1`` without
-    passing to its other side (a tangent point, a shared stretch it leaves on the same side) is
-    not a crossing. Both curves are closed unless ``closed=False``.
+    Crossings are decided with exact predicates under a symbolic perturbation (C2 shifted by an
+    infinitesimal vector to the right, then up), so every contact has a defined answer: a touch at
+    one point where C2 does not pass to the other side of C1 is not a crossing, and where it does
+    it is one. A shared (collinear) stretch that C2 passes through gives one crossing at an end of
+    the stretch; one that C2 leaves on the side it came from gives none or two (at both ends),
+    depending on the side the perturbation moves C2 to. Two closed curves cross an even number of
+    times. Both curves are closed unless ``closed=False``.
 
     Returns
     -------

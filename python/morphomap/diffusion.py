@@ -23,6 +23,8 @@ class DiffusionSolution:
         Where the streamline of -grad c from each point of C1 meets C2 (NaN if it does not).
     streamlines : list of (K, 2) float
         With ``streamlines=True``: the polyline of each streamline, from C1 to C2.
+    seconds : dict
+        Time spent meshing (the region and its Dirichlet vertices), solving and tracing.
     """
 
     vertices: np.ndarray
@@ -30,6 +32,7 @@ class DiffusionSolution:
     potential: np.ndarray
     ends: np.ndarray
     streamlines: list
+    seconds: dict
 
 
 def _length(value, name, default):
@@ -57,8 +60,8 @@ def solve_diffusion(c1, c2, *, closed=True, mesh_size=None, mesh_fraction=0.02, 
     -------
     DiffusionSolution
     """
-    vertices, triangles, potential, ends, lines = _core.solve_diffusion(
+    vertices, triangles, potential, ends, lines, seconds = _core.solve_diffusion(
         as_points(c1, "c1"), as_points(c2, "c2"), as_flag(closed, "closed"),
         _length(mesh_size, "mesh_size", 0.0), _length(mesh_fraction, "mesh_fraction", 0.02),
         as_flag(streamlines, "streamlines"))
-    return DiffusionSolution(vertices, triangles, potential, ends, list(lines))
+    return DiffusionSolution(vertices, triangles, potential, ends, list(lines), dict(seconds))

@@ -4,9 +4,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from . import _core
 from ._validate import as_flag, as_points
 from .field import DisplacementField
+from .surfaces import as_surface
 
 
 @dataclass(frozen=True)
@@ -19,11 +22,21 @@ class CurveQuality:
     crossings: int
 
 
-def quality(field, c1, c2, *, closed=True) -> CurveQuality:
-    r"""Quality measures QM1, QM2, QM and crossings of a 2D displacement field.
+@dataclass(frozen=True)
+class SurfaceQuality:
+    """Quality measures of a 3D displacement field; see :func:`quality` for the formulas."""
 
-    As in the paper's section "Quantitative Evaluation of the Mapping Algorithms". Only 2D fields
-    are accepted for now; the 3D measures are not available yet.
+    qm1: float
+    qm2: float
+    qm: float
+    folds: int
+
+
+def quality(field, c1, c2, *, closed=True):
+    r"""Quality measures of a displacement field: QM1, QM2, QM and crossings (2D) or folds (3D).
+
+    2D as in the paper's section "Quantitative Evaluation of the Mapping Algorithms"; 3D (a field
+    with ``faces``, from :func:`map_surfaces`) with our own analogues, see the Notes.
 
     Parameters
     ----------
@@ -32,15 +45,16 @@ def quality(field, c1, c2, *, closed=True) -> CurveQuality:
         every valid end point on ``c2`` (within :math:`10^{-6}` of the curve's bounding-box
         diagonal).
     c1, c2 : (N, 2) float
-        The curves at time t and t + dt.
+        The curves at time t and t + dt. 3D: the closed surfaces S1 and S2, each a
+        ``trimesh.Trimesh`` or a ``(vertices, faces)`` pair.
     closed : bool
-        Whether both curves are closed.
+        Whether both curves are closed (2D only).
 
     Returns
     -------
-    CurveQuality
+    CurveQuality or SurfaceQuality
         ``qm1``, ``qm2``, ``qm`` (float, NaN when there is nothing to average over) and
-        ``crossings`` (int).
+        ``crossings`` (2D) or ``folds`` (3D) (int).
 
     Notes
     -----
@@ -68,9 +82,40 @@ def quality(field, c1, c2, *, closed=True) -> CurveQuality:
 
     Runs in C++ on all cores without the GIL; each area walks only the curve vertices between two
     consecutive points.
+
+    **3D** (ours; the paper gives no formula). The elements are the triangles of ``field.faces``
+    (indices of the field's rows); a triangle with an invalid vector is skipped. Over the
+    :math:`K` remaining triangles :math:`j` with corners :math:`p_0, p_1, p_2` and images
+    :math:`P_0, P_1, P_2`:
+
+    - :math:`a_j = |(p_1 - p_0) \times (p_2 - p_0)| / 2` and :math:`A_j` the same of the images.
+    - :math:`\alpha = \mathrm{area}(S_2) / \mathrm{area}(S_1)` (sums of triangle areas).
+    - :math:`\mathrm{QM}_1 = \frac{1}{K_1} \sum_j \left(\frac{A_j}{\alpha a_j} - 1\right)^2`
+      over the :math:`K_1` triangles with :math:`a_j > 0`.
+    - :math:`V_j`, the volume swept between the start triangle and its image: the solid with the
+      two triangles as caps and the three vector quads as sides, split into the tetrahedra
+      :math:`(p_0 p_1 p_2 P_0)`, :math:`(p_1 p_2 P_0 P_1)`, :math:`(p_2 P_0 P_1 P_2)`;
+      :math:`V_j` is the sum of their absolute volumes.
+    - :math:`\mathrm{QM}_2 = \frac{1}{K} \sum_j \left(\frac{V_j}{\langle V \rangle} - 1\right)^2`
+      with :math:`\langle V \rangle = \frac{1}{K} \sum_j V_j`;
+      :math:`\mathrm{QM} = \mathrm{QM}_1 \cdot \mathrm{QM}_2`.
+    - ``folds``: the number of triangles whose image is turned over,
+      :math:`n_j \cdot N_j < 0` with :math:`n_j = (p_1 - p_0) \times (p_2 - p_0)` and
+      :math:`N_j` the same of the images.
+
+    Both surfaces must be closed; valid start points must lie on S1 and valid end points on S2
+    (within :math:`10^{-6}` of the surface's bounding-box diagonal).
     """
     if not isinstance(field, DisplacementField):
         raise TypeError(f"field: expected a DisplacementField, got {type(field).__name__}")
+    if field.dim == 3:
+        if field.faces is None:
+            raise ValueError("field: expected a 2D field, or a 3D field with faces (the connectivity of its start points)")
+        v1, f1 = as_surface(c1, "s1")
+        v2, f2 = as_surface(c2, "s2")
+        qm1, qm2, qm, folds = _core.surface_quality(
+            field.starts, field.ends, np.ascontiguousarray(field.faces, dtype=np.int64), v1, f1, v2, f2)
+        return SurfaceQuality(float(qm1), float(qm2), float(qm), int(folds))
     if field.dim != 2:
         raise ValueError(f"field: expected a 2D displacement field, got {field.dim}D")
     c1 = as_points(c1, "c1")

@@ -28,4 +28,18 @@ struct DisplacementField2 {
   }
 };
 
+// The same for surfaces: start points are the vertices of the source surface, and faces their
+// connectivity (so that quality can be measured).
+struct DisplacementField3 {
+  Points3 starts;
+  Points3 ends;
+  Faces faces;
+  std::vector<Method> methods;
+
+  Index size() const { return starts.rows(); }
+  bool valid(Index i) const {
+    return starts.row(i).allFinite() && ends.row(i).allFinite();
+  }
+};
+
 }  // namespace morphomap

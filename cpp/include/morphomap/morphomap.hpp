@@ -6,8 +6,11 @@
 #include <morphomap/curve_queries.hpp>
 #include <morphomap/errors.hpp>
 #include <morphomap/field.hpp>
+#include <morphomap/laplace3d.hpp>
 #include <morphomap/mapping.hpp>
 #include <morphomap/quality.hpp>
 #include <morphomap/resample.hpp>
+#include <morphomap/surface_mapping.hpp>
+#include <morphomap/surface_queries.hpp>
 #include <morphomap/transform.hpp>
 #include <morphomap/types.hpp>

@@ -37,3 +37,42 @@ CurveQuality quality(const DisplacementField2& field, const Points2Ref& c1, cons
                      bool closed = true);
 
 }  // namespace morphomap
+
+// ---- 3D ---------------------------------------------------------------------------------------
+namespace morphomap {
+
+struct SurfaceQuality {
+  double qm1 = 0.0;  // < (A_j / (alpha a_j) - 1)^2 >
+  double qm2 = 0.0;  // < (V_j / <V> - 1)^2 >
+  double qm = 0.0;   // qm1 * qm2
+  Index folds = 0;   // triangles whose image is turned over
+};
+
+// Number of triangles j of `faces` (rows of starts/ends; a triangle with a NaN row is skipped)
+// whose image is turned over: n_j . N_j < 0, where n_j = (p1 - p0) x (p2 - p0) of the start
+// points and N_j the same of the end points.
+Index count_folds(const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces);
+
+// Quality of a 3D field p_i -> P_i (our definitions; the paper gives none for 3D).
+//
+// Triangles: the rows of field.faces (indices into the field's rows); a triangle with an invalid
+// (NaN) vector is skipped. Over the remaining K triangles j with corners p0, p1, p2 and images
+// P0, P1, P2:
+//   a_j   = |(p1 - p0) x (p2 - p0)| / 2, A_j = the same of P0, P1, P2.
+//   alpha = area(S2) / area(S1) (sums of the triangle areas of the surfaces).
+//   QM1   = (1/K1) sum_j (A_j / (alpha a_j) - 1)^2 over the K1 triangles with a_j > 0.
+//   V_j   = the volume swept between the start triangle and its image: the solid with the two
+//           triangles as caps and the three vector quads as sides, split into the tetrahedra
+//           (p0 p1 p2 P0), (p1 p2 P0 P1), (p2 P0 P1 P2); V_j = sum of their absolute volumes.
+//   <V>   = (1/K) sum_j V_j,  QM2 = (1/K) sum_j (V_j / <V> - 1)^2.
+//   QM    = QM1 * QM2.
+// A measure is NaN when it has nothing to average over (no triangle, or <V> == 0).
+// folds = count_folds(field.starts, field.ends, field.faces).
+//
+// Both surfaces must pass check_closed_surface (named "s1", "s2"); every valid start point must
+// lie on S1 and every valid end point on S2 within 1e-6 of the surface's bounding-box diagonal,
+// and field.faces must index the field's rows, else InvalidInput naming "field".
+SurfaceQuality quality(const DisplacementField3& field, const Points3Ref& v1, const FacesRef& f1,
+                       const Points3Ref& v2, const FacesRef& f2);
+
+}  // namespace morphomap

@@ -1,0 +1,47 @@
+#pragma once
+// Diffusion mapping in 3D: the Laplace equation in the region between two closed surfaces.
+#include <morphomap/types.hpp>
+
+#include <vector>
+
+namespace morphomap {
+
+struct ShellDiffusionOptions {
+  // Largest tetrahedron size (CGAL Mesh_3 cell size); 0: a quarter of the mean gap between the
+  // surfaces (the shell's volume over the mean of their areas). Near each surface the mesh follows
+  // its mean edge length (or mesh_size, if smaller) and grows away from it by a tenth of the
+  // distance.
+  double mesh_size = 0.0;
+  bool keep_streamlines = false;
+};
+
+// Wall-clock seconds of the three stages.
+struct ShellDiffusionTimings {
+  double mesh = 0.0;   // nesting test and Mesh_3
+  double solve = 0.0;  // assembly and the sparse solve
+  double trace = 0.0;  // locating the starts, streamlines, projection onto the target
+};
+
+struct ShellDiffusionSolution {
+  Points3 vertices;        // the tetrahedral mesh of the region (Mesh_3: its boundary approximates
+  Tetrahedra tetrahedra;   // the surfaces; input vertices are not mesh vertices); positively oriented
+  Vector potential;        // c at the vertices: P1 finite elements, 1 on the source, 0 on the target
+  Points3 ends;            // for each source vertex, where its streamline of -grad c meets the
+                           // target surface (NaN if it does not)
+  std::vector<Points3> streamlines;  // with keep_streamlines: the source vertex, the streamline
+                                     // from the mesh boundary, and the end (NaN if lost)
+  ShellDiffusionTimings seconds;
+};
+
+// Both surfaces closed, edge-manifold and consistently oriented (either way round). The region: the
+// shell between them when one lies inside the other (which one is found). Crossing surfaces (each
+// piece of the symmetric difference on its own) are not supported yet: InvalidInput, as for
+// surfaces that lie apart. Streamlines start on the mesh boundary at the closest point to each
+// source vertex and follow the recovered, linearly interpolated -grad c in RK4 steps; where one
+// leaves the mesh through the target boundary, its end is moved to the closest point of the
+// target surface.
+ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, const FacesRef& source_faces,
+                                          const Points3Ref& target_vertices, const FacesRef& target_faces,
+                                          const ShellDiffusionOptions& options = {});
+
+}  // namespace morphomap

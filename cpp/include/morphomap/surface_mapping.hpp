@@ -1,0 +1,31 @@
+#pragma once
+// Displacement fields between two closed surfaces (the paper's section "Displacement Fields for
+// 3D Objects"): minimal distance, normal and diffusion mapping, reverse, and "auto".
+#include <morphomap/field.hpp>
+#include <morphomap/mapping.hpp>
+#include <morphomap/types.hpp>
+
+namespace morphomap {
+
+struct SurfaceMappingOptions {
+  // minimal_distance: each vertex to its closest point on the target.
+  // normal: the line through each vertex along its angle-weighted normal, both directions, to the
+  //   nearest intersection with the target; NaN where it meets nothing.
+  // diffusion: streamlines of Laplace's equation between the surfaces (solve_diffusion_3d); the
+  //   ends are put onto their closest point of the target (the tetrahedral mesh only
+  //   approximates it).
+  // automatic: normal mapping; if it misses anywhere or folds a triangle (count_folds), reverse
+  //   diffusion for the whole surface instead (methods tells which).
+  // uniform has no 3D form: InvalidInput.
+  MapMethod method = MapMethod::normal;
+  bool reverse = false;  // map S2 -> S1 and flip: starts on S1, ends on S2, rows and faces of S2
+  double diffusion_mesh_size = 0.0;  // ShellDiffusionOptions::mesh_size (0: automatic)
+};
+
+// Both surfaces must pass check_closed_surface (named "s1" and "s2"). Start points are the
+// vertices of the source surface (S1, or S2 when reversed), in its order; field.faces are its
+// faces. A reverse vector that finds no start point on S1 is NaN in starts and ends.
+DisplacementField3 map_surfaces(const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2,
+                                const FacesRef& f2, const SurfaceMappingOptions& options = {});
+
+}  // namespace morphomap

@@ -1,0 +1,142 @@
+// The quality measures of a 3D displacement field (ours; see quality.hpp for the formulas).
+#include <morphomap/quality.hpp>
+#include <morphomap/surface_queries.hpp>
+
+#include "surface_util.hpp"
+#include "validation.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace morphomap {
+
+namespace {
+
+using detail::V3;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+bool usable(const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, Index j) {
+  for (int k = 0; k < 3; ++k) {
+    const Index i = faces(j, k);
+    if (!starts.row(i).allFinite() || !ends.row(i).allFinite()) return false;
+  }
+  return true;
+}
+
+void require_field_faces(const FacesRef& faces, Index rows, const char* name) {
+  for (Index j = 0; j < faces.rows(); ++j) {
+    for (int k = 0; k < 3; ++k) {
+      if (faces(j, k) < 0 || faces(j, k) >= rows) {
+        detail::invalid(name, "face " + std::to_string(j) + " refers to row " + std::to_string(faces(j, k)) +
+                                  ", outside 0.." + std::to_string(rows - 1));
+      }
+    }
+  }
+}
+
+double surface_area(const Points3Ref& v, const FacesRef& f) {
+  double area = 0.0;
+  for (Index j = 0; j < f.rows(); ++j) {
+    const V3 a = detail::corner(v, f, j, 0);
+    area += 0.5 * (detail::corner(v, f, j, 1) - a).cross(detail::corner(v, f, j, 2) - a).norm();
+  }
+  return area;
+}
+
+double tetrahedron(const V3& a, const V3& b, const V3& c, const V3& d) {
+  return std::abs((b - a).dot((c - a).cross(d - a))) / 6.0;
+}
+
+// Every valid row of `points` within `tolerance` of the surface.
+void require_on(const Points3Ref& points, const Points3Ref& v, const FacesRef& f, const char* what) {
+  std::vector<Index> rows;
+  for (Index i = 0; i < points.rows(); ++i) {
+    if (points.row(i).allFinite()) rows.push_back(i);
+  }
+  if (rows.empty()) return;
+  Points3 found(rows.size(), 3);
+  for (std::size_t k = 0; k < rows.size(); ++k) found.row(k) = points.row(rows[k]);
+  const double tolerance = 1e-6 * (v.colwise().maxCoeff() - v.colwise().minCoeff()).norm();
+  const Vector d = SurfaceIndex(v, f).closest_points(found).distances;
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    if (!(d[k] <= tolerance)) {
+      detail::invalid("field", std::string(what) + " " + std::to_string(rows[k]) + " is " + std::to_string(d[k]) +
+                                   " away from the surface it should lie on");
+    }
+  }
+}
+
+}  // namespace
+
+Index count_folds(const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces) {
+  if (ends.rows() != starts.rows()) detail::invalid("ends", "must have as many rows as starts");
+  require_field_faces(faces, starts.rows(), "faces");
+  return tbb::parallel_reduce(
+      tbb::blocked_range<Index>(0, faces.rows(), 1024), Index{0},
+      [&](const tbb::blocked_range<Index>& range, Index count) {
+        for (Index j = range.begin(); j < range.end(); ++j) {
+          if (!usable(starts, ends, faces, j)) continue;
+          const V3 p0 = detail::corner(starts, faces, j, 0), q0 = detail::corner(ends, faces, j, 0);
+          const V3 n = (detail::corner(starts, faces, j, 1) - p0).cross(detail::corner(starts, faces, j, 2) - p0);
+          const V3 m = (detail::corner(ends, faces, j, 1) - q0).cross(detail::corner(ends, faces, j, 2) - q0);
+          if (n.dot(m) < 0) ++count;
+        }
+        return count;
+      },
+      [](Index a, Index b) { return a + b; });
+}
+
+SurfaceQuality quality(const DisplacementField3& field, const Points3Ref& v1, const FacesRef& f1,
+                       const Points3Ref& v2, const FacesRef& f2) {
+  check_closed_surface(v1, f1, "s1");
+  check_closed_surface(v2, f2, "s2");
+  if (field.ends.rows() != field.starts.rows() || field.starts.cols() != 3 || field.ends.cols() != 3) {
+    detail::invalid("field", "starts and ends must both have shape (M, 3)");
+  }
+  require_field_faces(field.faces, field.size(), "field");
+  require_on(field.starts, v1, f1, "start point");
+  require_on(field.ends, v2, f2, "end point");
+
+  const double alpha = surface_area(v2, f2) / surface_area(v1, f1);
+  const Index count = field.faces.rows();
+  std::vector<double> ratio(count, kNaN), volume(count, kNaN);
+  for (Index j = 0; j < count; ++j) {
+    if (!usable(field.starts, field.ends, field.faces, j)) continue;
+    const V3 p0 = detail::corner(field.starts, field.faces, j, 0), p1 = detail::corner(field.starts, field.faces, j, 1),
+             p2 = detail::corner(field.starts, field.faces, j, 2);
+    const V3 q0 = detail::corner(field.ends, field.faces, j, 0), q1 = detail::corner(field.ends, field.faces, j, 1),
+             q2 = detail::corner(field.ends, field.faces, j, 2);
+    const double a = 0.5 * (p1 - p0).cross(p2 - p0).norm();
+    const double image = 0.5 * (q1 - q0).cross(q2 - q0).norm();
+    if (a > 0) ratio[j] = image / (alpha * a);
+    volume[j] = tetrahedron(p0, p1, p2, q0) + tetrahedron(p1, p2, q0, q1) + tetrahedron(p2, q0, q1, q2);
+  }
+  SurfaceQuality q;
+  double sum1 = 0.0, sum_v = 0.0;
+  Index k1 = 0, k = 0;
+  for (Index j = 0; j < count; ++j) {
+    if (std::isfinite(ratio[j])) sum1 += (ratio[j] - 1.0) * (ratio[j] - 1.0), ++k1;
+    if (std::isfinite(volume[j])) sum_v += volume[j], ++k;
+  }
+  q.qm1 = k1 > 0 ? sum1 / k1 : kNaN;
+  const double mean_v = k > 0 ? sum_v / k : kNaN;
+  if (k > 0 && mean_v > 0) {
+    double sum2 = 0.0;
+    for (Index j = 0; j < count; ++j) {
+      if (std::isfinite(volume[j])) sum2 += (volume[j] / mean_v - 1.0) * (volume[j] / mean_v - 1.0);
+    }
+    q.qm2 = sum2 / k;
+  } else {
+    q.qm2 = kNaN;
+  }
+  q.qm = q.qm1 * q.qm2;
+  q.folds = count_folds(field.starts, field.ends, field.faces);
+  return q;
+}
+
+}  // namespace morphomap

@@ -1,0 +1,49 @@
+#pragma once
+// The region between two closed surfaces as a tetrahedral mesh (CGAL's Mesh_3), and closest
+// points on triangle sets (CGAL's AABB tree). Kept small and stable: the translation unit behind
+// it compiles for minutes.
+#include <morphomap/types.hpp>
+
+namespace morphomap::detail {
+
+// How two closed, outward-oriented surfaces lie relative to each other.
+enum class Nesting { source_inside, target_inside, disjoint, crossing };
+Nesting classify_nesting(const Points3Ref& source_vertices, const FacesRef& source_faces,
+                         const Points3Ref& target_vertices, const FacesRef& target_faces);
+
+struct ShellMeshCriteria {
+  // Target edge length: source_size + grading * (distance to the source surface) near the source,
+  // likewise near the target, the smaller of the two, never above cell_size.
+  double source_size = 0.0;
+  double target_size = 0.0;
+  double grading = 0.0;
+  double cell_size = 0.0;
+  double facet_distance = 0.0;  // largest distance between the mesh boundary and the surfaces
+  bool exude = true;            // remove slivers after refinement
+};
+
+enum FacePatch : signed char { interior_face = 0, source_face = 1, target_face = 2, other_face = -1 };
+
+struct ShellMesh {
+  Points3 vertices;
+  Tetrahedra tetrahedra;         // positively oriented
+  Tetrahedra neighbours;         // neighbours(t, i): the tetrahedron across the face opposite
+                                 // vertex i of t, or -1 on the boundary
+  Eigen::Matrix<signed char, Eigen::Dynamic, 4, Eigen::RowMajor> patches;  // FacePatch of each face
+};
+
+// Both surfaces closed, consistently oriented outwards (positive volume) and not crossing; inner
+// and outer as classify_nesting found them. Throws GeometryError if Mesh_3 fails.
+ShellMesh mesh_shell(const Points3Ref& source_vertices, const FacesRef& source_faces,
+                     const Points3Ref& target_vertices, const FacesRef& target_faces, bool source_inside,
+                     const ShellMeshCriteria& criteria);
+
+struct TriangleHits {
+  Points3 points;     // closest point on the triangles
+  IndexVector faces;  // the triangle it lies on
+};
+
+// Closest point on a set of triangles (any soup, at least one triangle) to each query, in parallel.
+TriangleHits closest_on_triangles(const Points3Ref& vertices, const FacesRef& faces, const Points3Ref& queries);
+
+}  // namespace morphomap::detail

@@ -1,0 +1,296 @@
+// Line intersections and closest points against a triangle surface through Embree: the only file
+// that includes Embree. Embree works in single precision, so the triangles are placed in a unit box
+// before the scene is built, and every hit is refined in double precision on the original
+// triangles afterwards.
+#include <morphomap/errors.hpp>
+#include <morphomap/surface_queries.hpp>
+
+#include "surface_util.hpp"
+#include "validation.hpp"
+
+#include <embree3/rtcore.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace morphomap {
+
+namespace {
+
+using detail::V3;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr Index kGrain = 64;
+// A refined hit whose barycentric coordinates leave its triangle by more than this is looked for
+// among the triangles around it (Embree's float test and the double test disagree near edges).
+constexpr double kInsideSlack = 1e-12;
+// The looser slack of that search, so that a line through an edge or vertex always finds a face.
+constexpr double kRingSlack = 1e-9;
+
+struct Hit {
+  V3 point{kNaN, kNaN, kNaN};
+  double distance = kNaN;
+  Index face = -1;
+};
+
+// Nearer the origin first, then the positive side, then the lower face.
+bool line_hit_before(double t, Index face, const Hit& best) {
+  if (best.face < 0) return true;
+  const double at = std::abs(t), ab = std::abs(best.distance);
+  if (at != ab) return at < ab;
+  if ((t < 0) != (best.distance < 0)) return t >= 0;
+  return face < best.face;
+}
+
+}  // namespace
+
+struct SurfaceIndex::Impl {
+  Points3 vertices;
+  Faces faces;
+  V3 centre = V3::Zero();
+  double scale = 1.0;  // unit-box coordinates are (x - centre) * scale
+  std::vector<Index> ring_start, ring_faces;  // faces around each vertex (CSR)
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+
+  Impl(const Points3Ref& v, const FacesRef& f) : vertices(v), faces(f) {
+    detail::require_finite3(vertices, "vertices");
+    if (faces.rows() == 0) detail::invalid("faces", "the surface has no face");
+    if (faces.rows() >= (Index{1} << 31) || vertices.rows() >= (Index{1} << 31)) {
+      detail::invalid("faces", "too many faces or vertices for the index (at most 2^31 - 1)");
+    }
+    detail::require_face_indices(faces, vertices.rows(), "faces");
+
+    const V3 lo = vertices.colwise().minCoeff().transpose(), hi = vertices.colwise().maxCoeff().transpose();
+    centre = 0.5 * (lo + hi);
+    const double extent = (hi - lo).maxCoeff();
+    scale = extent > 0 ? 1.0 / extent : 1.0;
+
+    ring_start.assign(vertices.rows() + 1, 0);
+    for (Index j = 0; j < faces.rows(); ++j) {
+      for (int k = 0; k < 3; ++k) ++ring_start[faces(j, k) + 1];
+    }
+    for (Index i = 0; i < vertices.rows(); ++i) ring_start[i + 1] += ring_start[i];
+    ring_faces.resize(ring_start.back());
+    std::vector<Index> fill(ring_start.begin(), ring_start.end() - 1);
+    for (Index j = 0; j < faces.rows(); ++j) {
+      for (int k = 0; k < 3; ++k) ring_faces[fill[faces(j, k)]++] = j;
+    }
+
+    device = rtcNewDevice(nullptr);
+    if (!device) throw GeometryError("Embree could not create a device");
+    scene = rtcNewScene(device);
+    // Robust mode makes the triangle test watertight: a ray through a shared edge hits a face.
+    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_MEDIUM);
+    RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                           3 * sizeof(float), vertices.rows()));
+    auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                              3 * sizeof(unsigned), faces.rows()));
+    if (!vb || !ib) {
+      rtcReleaseGeometry(geometry);
+      release();
+      throw GeometryError("Embree could not allocate the geometry buffers");
+    }
+    for (Index i = 0; i < vertices.rows(); ++i) {
+      for (int k = 0; k < 3; ++k) vb[3 * i + k] = static_cast<float>((vertices(i, k) - centre[k]) * scale);
+    }
+    for (Index j = 0; j < faces.rows(); ++j) {
+      for (int k = 0; k < 3; ++k) ib[3 * j + k] = static_cast<unsigned>(faces(j, k));
+    }
+    rtcCommitGeometry(geometry);
+    rtcAttachGeometry(scene, geometry);
+    rtcReleaseGeometry(geometry);
+    rtcCommitScene(scene);
+    if (rtcGetDeviceError(device) != RTC_ERROR_NONE) {
+      const RTCError error = rtcGetDeviceError(device);
+      release();
+      throw GeometryError("Embree failed to build the scene (error " + std::to_string(static_cast<int>(error)) + ")");
+    }
+  }
+
+  ~Impl() { release(); }
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
+
+  void release() {
+    if (scene) rtcReleaseScene(scene), scene = nullptr;
+    if (device) rtcReleaseDevice(device), device = nullptr;
+  }
+
+  V3 corner(Index face, int k) const { return vertices.row(faces(face, k)).transpose(); }
+
+  // The Embree hit `face` of the line o + t u, refined in double precision; when the refined
+  // point falls outside that face, the faces around its corners are tried as well.
+  void refine(const V3& o, const V3& u, Index face, Hit& best) const {
+    double t = 0.0, outside = 0.0;
+    if (detail::line_triangle(o, u, corner(face, 0), corner(face, 1), corner(face, 2), kInsideSlack, t, outside)) {
+      if (line_hit_before(t, face, best)) best.distance = t, best.face = face;
+      return;
+    }
+    Hit ring;
+    for (int k = 0; k < 3; ++k) {
+      const Index v = faces(face, k);
+      for (Index r = ring_start[v]; r < ring_start[v + 1]; ++r) {
+        const Index g = ring_faces[r];
+        if (detail::line_triangle(o, u, corner(g, 0), corner(g, 1), corner(g, 2), kRingSlack, t, outside) &&
+            line_hit_before(t, g, ring)) {
+          ring.distance = t, ring.face = g;
+        }
+      }
+    }
+    if (ring.face < 0) {
+      // Parallel in double, or outside the whole neighbourhood: keep the plane of Embree's face
+      // (the float test found the line there, so the point is within rounding of it).
+      const V3 a = corner(face, 0), n = (corner(face, 1) - a).cross(corner(face, 2) - a);
+      const double denom = n.dot(u);
+      if (denom == 0.0 || !(n.squaredNorm() > 0)) return;
+      ring.distance = n.dot(a - o) / denom, ring.face = face;
+      if (!std::isfinite(ring.distance)) return;
+    }
+    if (line_hit_before(ring.distance, ring.face, best)) best = ring;
+  }
+
+  Hit line(const V3& o, const V3& u) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    const V3 os = (o - centre) * scale;
+    Hit best;
+    for (const double sign : {1.0, -1.0}) {
+      RTCRayHit rh;
+      rh.ray.org_x = static_cast<float>(os.x()), rh.ray.org_y = static_cast<float>(os.y()),
+      rh.ray.org_z = static_cast<float>(os.z());
+      rh.ray.dir_x = static_cast<float>(sign * u.x()), rh.ray.dir_y = static_cast<float>(sign * u.y()),
+      rh.ray.dir_z = static_cast<float>(sign * u.z());
+      rh.ray.tnear = 0.0f;
+      rh.ray.tfar = std::numeric_limits<float>::infinity();
+      rh.ray.time = 0.0f;
+      rh.ray.mask = 0xFFFFFFFFu;
+      rh.ray.id = 0;
+      rh.ray.flags = 0;
+      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+      rtcIntersect1(scene, &context, &rh);
+      if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) refine(o, u, static_cast<Index>(rh.hit.primID), best);
+    }
+    if (best.face >= 0) best.point = o + best.distance * u;
+    return best;
+  }
+
+  struct PointQuery {
+    const Impl* self;
+    V3 q;
+    double margin;  // float rounding of the query and of the scene, in unit-box units
+    double best_d2 = kInf;
+    Hit hit;
+  };
+
+  // Embree calls this for every triangle within the query radius; the distance is measured in
+  // double precision on the original triangle and the radius shrunk (with a rounding margin).
+  static bool visit(RTCPointQueryFunctionArguments* args) {
+    auto* pq = static_cast<PointQuery*>(args->userPtr);
+    const Impl& self = *pq->self;
+    const Index face = args->primID;
+    const V3 p = detail::closest_on_triangle(pq->q, self.corner(face, 0), self.corner(face, 1), self.corner(face, 2));
+    const double d2 = (p - pq->q).squaredNorm();
+    if (d2 < pq->best_d2 || (d2 == pq->best_d2 && face < pq->hit.face)) {
+      pq->best_d2 = d2;
+      pq->hit.point = p;
+      pq->hit.face = face;
+      const float radius = static_cast<float>(std::sqrt(d2) * self.scale * (1.0 + 1e-6) + pq->margin);
+      if (radius < args->query->radius) {
+        args->query->radius = radius;
+        return true;
+      }
+    }
+    return false;
+  }
+
+  Hit closest(const V3& q) const {
+    const V3 qs = (q - centre) * scale;
+    PointQuery pq{this, q, 1e-6 * (1.0 + qs.cwiseAbs().maxCoeff()), kInf, Hit{}};
+    RTCPointQuery query;
+    query.x = static_cast<float>(qs.x()), query.y = static_cast<float>(qs.y()), query.z = static_cast<float>(qs.z());
+    query.time = 0.0f;
+    query.radius = std::numeric_limits<float>::infinity();
+    RTCPointQueryContext context;
+    rtcInitPointQueryContext(&context);
+    rtcPointQuery(scene, &query, &context, &Impl::visit, &pq);
+    pq.hit.distance = std::sqrt(pq.best_d2);
+    return pq.hit;
+  }
+};
+
+namespace {
+
+SurfaceHits allocate_hits(Index rows) {
+  SurfaceHits hits;
+  hits.points.resize(rows, 3);
+  hits.distances.resize(rows);
+  hits.faces.resize(rows);
+  return hits;
+}
+
+void store(SurfaceHits& hits, Index i, const Hit& hit) {
+  hits.points.row(i) = hit.point.transpose();
+  hits.distances[i] = hit.face >= 0 ? hit.distance : kNaN;
+  hits.faces[i] = hit.face;
+}
+
+}  // namespace
+
+SurfaceIndex::SurfaceIndex(const Points3Ref& vertices, const FacesRef& faces)
+    : impl_(std::make_unique<Impl>(vertices, faces)) {}
+SurfaceIndex::~SurfaceIndex() = default;
+SurfaceIndex::SurfaceIndex(SurfaceIndex&&) noexcept = default;
+SurfaceIndex& SurfaceIndex::operator=(SurfaceIndex&&) noexcept = default;
+
+SurfaceHits SurfaceIndex::closest_points(const Points3Ref& queries) const {
+  detail::require_finite3(queries, "queries");
+  SurfaceHits hits = allocate_hits(queries.rows());
+  tbb::parallel_for(tbb::blocked_range<Index>(0, queries.rows(), kGrain), [&](const tbb::blocked_range<Index>& range) {
+    for (Index i = range.begin(); i < range.end(); ++i) store(hits, i, impl_->closest(queries.row(i).transpose()));
+  });
+  return hits;
+}
+
+SurfaceHits SurfaceIndex::line_intersections(const Points3Ref& origins, const Points3Ref& directions) const {
+  detail::require_finite3(origins, "origins");
+  detail::require_finite3(directions, "directions");
+  if (origins.rows() != directions.rows()) {
+    detail::invalid("directions", "has " + std::to_string(directions.rows()) + " rows but origins has " +
+                                      std::to_string(origins.rows()));
+  }
+  for (Index i = 0; i < directions.rows(); ++i) {
+    if (!(directions.row(i).cwiseAbs().maxCoeff() > 0)) {
+      detail::invalid("directions", "row " + std::to_string(i) + " is the zero vector");
+    }
+  }
+  SurfaceHits hits = allocate_hits(origins.rows());
+  tbb::parallel_for(tbb::blocked_range<Index>(0, origins.rows(), kGrain), [&](const tbb::blocked_range<Index>& range) {
+    for (Index i = range.begin(); i < range.end(); ++i) {
+      const V3 d = directions.row(i).transpose();
+      store(hits, i, impl_->line(origins.row(i).transpose(), d / d.stableNorm()));
+    }
+  });
+  return hits;
+}
+
+SurfaceHits closest_points(const Points3Ref& queries, const Points3Ref& vertices, const FacesRef& faces) {
+  return SurfaceIndex(vertices, faces).closest_points(queries);
+}
+
+SurfaceHits line_intersections(const Points3Ref& origins, const Points3Ref& directions, const Points3Ref& vertices,
+                               const FacesRef& faces) {
+  return SurfaceIndex(vertices, faces).line_intersections(origins, directions);
+}
+
+}  // namespace morphomap

@@ -1,0 +1,107 @@
+// The paper's 3D mapping: minimal distance, normal and diffusion mapping of the vertices of one
+// closed surface onto another, with reverse and "auto" (normal, else reverse diffusion).
+#include <morphomap/laplace3d.hpp>
+#include <morphomap/quality.hpp>
+#include <morphomap/surface_mapping.hpp>
+#include <morphomap/surface_queries.hpp>
+
+#include "validation.hpp"
+
+#include <morphomap/errors.hpp>
+
+#include <cmath>
+#include <limits>
+#include <utility>
+#include <vector>
+
+namespace morphomap {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+struct Surface {
+  Points3Ref vertices;
+  FacesRef faces;
+};
+
+// Vectors from the vertices of `source` to `target` with one basic algorithm.
+DisplacementField3 basic(MapMethod method, const Surface& source, const Surface& target, double mesh_size) {
+  DisplacementField3 field;
+  field.starts = source.vertices;
+  field.faces = source.faces;
+  switch (method) {
+    case MapMethod::minimal_distance:
+      field.ends = SurfaceIndex(target.vertices, target.faces).closest_points(field.starts).points;
+      field.methods.assign(field.size(), Method::minimal_distance);
+      break;
+    case MapMethod::normal: {
+      const Points3 normals = vertex_normals(source.vertices, source.faces);
+      field.ends = SurfaceIndex(target.vertices, target.faces).line_intersections(field.starts, normals).points;
+      field.methods.assign(field.size(), Method::normal);
+      break;
+    }
+    case MapMethod::diffusion: {
+      ShellDiffusionOptions options;
+      options.mesh_size = mesh_size;
+      const ShellDiffusionSolution solution =
+          solve_diffusion_3d(source.vertices, source.faces, target.vertices, target.faces, options);
+      if (solution.ends.rows() != field.size()) throw GeometryError("diffusion: the solver returned the wrong number of ends");
+      // The tetrahedral mesh only approximates the target: put each end onto the target itself.
+      field.ends = solution.ends;
+      Points3 found(0, 3);
+      std::vector<Index> rows;
+      for (Index i = 0; i < field.size(); ++i) {
+        if (field.ends.row(i).allFinite()) rows.push_back(i);
+      }
+      found.resize(rows.size(), 3);
+      for (std::size_t k = 0; k < rows.size(); ++k) found.row(k) = field.ends.row(rows[k]);
+      const Points3 on_target = SurfaceIndex(target.vertices, target.faces).closest_points(found).points;
+      for (std::size_t k = 0; k < rows.size(); ++k) field.ends.row(rows[k]) = on_target.row(k);
+      field.methods.assign(field.size(), Method::diffusion);
+      break;
+    }
+    default:
+      detail::invalid("method", "uniform mapping has no 3D form; use 'minimal_distance', 'normal', 'diffusion' or 'auto'");
+  }
+  return field;
+}
+
+// A field from one surface to another turned round (starts and ends swapped, rows and faces kept);
+// a row that found nothing is NaN as a whole.
+DisplacementField3 flipped(DisplacementField3 field) {
+  std::swap(field.starts, field.ends);
+  for (Index i = 0; i < field.size(); ++i) {
+    if (!field.valid(i)) field.starts.row(i).setConstant(kNaN), field.ends.row(i).setConstant(kNaN);
+  }
+  return field;
+}
+
+DisplacementField3 directed(MapMethod method, const Surface& source, const Surface& target, double mesh_size) {
+  if (method != MapMethod::automatic) return basic(method, source, target, mesh_size);
+  DisplacementField3 field = basic(MapMethod::normal, source, target, mesh_size);
+  bool missed = false;
+  for (Index i = 0; i < field.size() && !missed; ++i) missed = !field.valid(i);
+  if (!missed && count_folds(field.starts, field.ends, field.faces) == 0) return field;
+  // Reverse diffusion: streamlines from the target's vertices back to the source, turned round.
+  return flipped(basic(MapMethod::diffusion, target, source, mesh_size));
+}
+
+}  // namespace
+
+DisplacementField3 map_surfaces(const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2,
+                                const SurfaceMappingOptions& options) {
+  check_closed_surface(v1, f1, "s1");
+  check_closed_surface(v2, f2, "s2");
+  if (options.method == MapMethod::uniform) {
+    detail::invalid("method", "uniform mapping has no 3D form; use 'minimal_distance', 'normal', 'diffusion' or 'auto'");
+  }
+  if (!(options.diffusion_mesh_size >= 0) || !std::isfinite(options.diffusion_mesh_size)) {
+    detail::invalid("mesh_size", "must be a finite number >= 0");
+  }
+  const Surface s1{v1, f1}, s2{v2, f2};
+  if (!options.reverse) return directed(options.method, s1, s2, options.diffusion_mesh_size);
+  return flipped(directed(options.method, s2, s1, options.diffusion_mesh_size));
+}
+
+}  // namespace morphomap

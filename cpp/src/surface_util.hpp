@@ -1,0 +1,83 @@
+#pragma once
+// Small double-precision triangle helpers and input checks shared by the surface kernels.
+#include <morphomap/types.hpp>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+
+#include <string>
+
+namespace morphomap::detail {
+
+using V3 = Eigen::Vector3d;
+
+// Every coordinate finite, else InvalidInput "name: row i has a non-finite coordinate".
+void require_finite3(const Points3Ref& points, const char* name);
+
+// Every index in [0, vertex_count), else InvalidInput naming `name`.
+void require_face_indices(const FacesRef& faces, Index vertex_count, const char* name);
+
+inline V3 corner(const Points3Ref& v, const FacesRef& f, Index face, int k) {
+  return v.row(f(face, k)).transpose();
+}
+
+// Closest point to p on triangle abc (Ericson, "Real-Time Collision Detection" 5.1.5: walk the
+// Voronoi regions of the vertices, edges and face); exact for degenerate triangles too.
+inline V3 closest_on_triangle(const V3& p, const V3& a, const V3& b, const V3& c) {
+  const V3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const V3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + (d1 / (d1 - d3)) * ab;
+  const V3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + (d2 / (d2 - d6)) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
+  const double sum = va + vb + vc;
+  if (!(sum > 0)) {  // degenerate (collinear) triangle: the nearest of its three edges
+    V3 best = a;
+    double best_d2 = (p - a).squaredNorm();
+    const V3* ends[3][2] = {{&a, &b}, {&b, &c}, {&c, &a}};
+    for (auto& e : ends) {
+      const V3 d = *e[1] - *e[0];
+      const double len2 = d.squaredNorm();
+      const double t = len2 > 0 ? std::min(std::max((p - *e[0]).dot(d) / len2, 0.0), 1.0) : 0.0;
+      const V3 q = *e[0] + t * d;
+      if ((p - q).squaredNorm() < best_d2) best_d2 = (p - q).squaredNorm(), best = q;
+    }
+    return best;
+  }
+  const double v = vb / sum, w = vc / sum;
+  return a + v * ab + w * ac;
+}
+
+// Intersection of the line o + t u with triangle abc (Moller-Trumbore in double precision);
+// barycentric coordinates may be outside [0, 1] by `slack`. False for a line parallel to the
+// triangle's plane.
+inline bool line_triangle(const V3& o, const V3& u, const V3& a, const V3& b, const V3& c,
+                          double slack, double& t, double& outside) {
+  const V3 e1 = b - a, e2 = c - a;
+  const V3 pvec = u.cross(e2);
+  const double det = e1.dot(pvec);
+  if (det == 0.0 || !std::isfinite(det)) return false;
+  const double inv = 1.0 / det;
+  const V3 s = o - a;
+  const double bu = s.dot(pvec) * inv;
+  const V3 qvec = s.cross(e1);
+  const double bv = u.dot(qvec) * inv;
+  outside = std::max({-bu, -bv, bu + bv - 1.0, 0.0});
+  if (outside > slack) return false;
+  t = e2.dot(qvec) * inv;
+  return std::isfinite(t);
+}
+
+}  // namespace morphomap::detail

@@ -1,0 +1,35 @@
+// Bindings of 3D diffusion mapping: the Laplace problem in the shell between two closed surfaces.
+#include <pybind11/eigen.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <morphomap/laplace3d.hpp>
+
+namespace py = pybind11;
+using namespace morphomap;
+
+void bind_diffusion3d(py::module_& m) {
+  m.def(
+      "solve_diffusion_3d",
+      [](const Points3Ref& source_vertices, const FacesRef& source_faces, const Points3Ref& target_vertices,
+         const FacesRef& target_faces, double mesh_size, bool keep_streamlines) {
+        ShellDiffusionOptions options;
+        options.mesh_size = mesh_size;
+        options.keep_streamlines = keep_streamlines;
+        ShellDiffusionSolution solution;
+        {
+          py::gil_scoped_release release;
+          solution = solve_diffusion_3d(source_vertices, source_faces, target_vertices, target_faces, options);
+        }
+        py::list streamlines;
+        for (Points3& line : solution.streamlines) streamlines.append(py::cast(std::move(line)));
+        py::dict seconds;
+        seconds["mesh"] = solution.seconds.mesh;
+        seconds["solve"] = solution.seconds.solve;
+        seconds["trace"] = solution.seconds.trace;
+        return py::make_tuple(std::move(solution.vertices), std::move(solution.tetrahedra),
+                              std::move(solution.potential), std::move(solution.ends), streamlines, seconds);
+      },
+      py::arg("source_vertices"), py::arg("source_faces"), py::arg("target_vertices"), py::arg("target_faces"),
+      py::arg("mesh_size"), py::arg("keep_streamlines"));
+}

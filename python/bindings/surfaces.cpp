@@ -1,0 +1,100 @@
+// Bindings of the 3D surface kernels: SurfaceIndex, vertex normals, map_surfaces and quality.
+#include <pybind11/eigen.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <morphomap/errors.hpp>
+#include <morphomap/quality.hpp>
+#include <morphomap/surface_mapping.hpp>
+#include <morphomap/surface_queries.hpp>
+
+namespace py = pybind11;
+using namespace morphomap;
+
+namespace {
+
+using Release = py::call_guard<py::gil_scoped_release>;
+
+MapMethod surface_method(const std::string& name) {
+  if (name == "minimal_distance") return MapMethod::minimal_distance;
+  if (name == "normal") return MapMethod::normal;
+  if (name == "diffusion") return MapMethod::diffusion;
+  if (name == "auto") return MapMethod::automatic;
+  throw InvalidInput("method: expected 'minimal_distance', 'normal', 'diffusion' or 'auto', got '" + name + "'");
+}
+
+py::tuple hits_tuple(SurfaceHits&& h) {
+  return py::make_tuple(std::move(h.points), std::move(h.distances), std::move(h.faces));
+}
+
+}  // namespace
+
+void bind_surfaces(py::module_& m) {
+  py::class_<SurfaceIndex>(m, "SurfaceIndex")
+      .def(py::init<const Points3Ref&, const FacesRef&>(), py::arg("vertices"), py::arg("faces"), Release())
+      .def(
+          "closest_points",
+          [](const SurfaceIndex& index, const Points3Ref& queries) {
+            SurfaceHits hits;
+            {
+              py::gil_scoped_release release;
+              hits = index.closest_points(queries);
+            }
+            return hits_tuple(std::move(hits));
+          },
+          py::arg("queries"))
+      .def(
+          "line_intersections",
+          [](const SurfaceIndex& index, const Points3Ref& origins, const Points3Ref& directions) {
+            SurfaceHits hits;
+            {
+              py::gil_scoped_release release;
+              hits = index.line_intersections(origins, directions);
+            }
+            return hits_tuple(std::move(hits));
+          },
+          py::arg("origins"), py::arg("directions"));
+
+  m.def("vertex_normals", &vertex_normals, py::arg("vertices"), py::arg("faces"), Release());
+  m.def(
+      "check_closed_surface",
+      [](const Points3Ref& vertices, const FacesRef& faces, const std::string& name) {
+        py::gil_scoped_release release;
+        return check_closed_surface(vertices, faces, name.c_str());
+      },
+      py::arg("vertices"), py::arg("faces"), py::arg("name"));
+
+  m.def(
+      "map_surfaces",
+      [](const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2,
+         const std::string& method, bool reverse) {
+        SurfaceMappingOptions options;
+        options.method = surface_method(method);
+        options.reverse = reverse;
+        DisplacementField3 field;
+        {
+          py::gil_scoped_release release;
+          field = map_surfaces(v1, f1, v2, f2, options);
+        }
+        Eigen::Matrix<std::int8_t, Eigen::Dynamic, 1> codes(field.methods.size());
+        for (std::size_t i = 0; i < field.methods.size(); ++i) codes[i] = static_cast<std::int8_t>(field.methods[i]);
+        return py::make_tuple(std::move(field.starts), std::move(field.ends), std::move(codes), std::move(field.faces));
+      },
+      py::arg("v1"), py::arg("f1"), py::arg("v2"), py::arg("f2"), py::arg("method"), py::arg("reverse"));
+
+  m.def(
+      "surface_quality",
+      [](const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, const Points3Ref& v1,
+         const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2) {
+        SurfaceQuality q;
+        {
+          py::gil_scoped_release release;
+          DisplacementField3 field{starts, ends, faces, {}};
+          q = quality(field, v1, f1, v2, f2);
+        }
+        return py::make_tuple(q.qm1, q.qm2, q.qm, q.folds);
+      },
+      py::arg("starts"), py::arg("ends"), py::arg("faces"), py::arg("v1"), py::arg("f1"), py::arg("v2"),
+      py::arg("f2"));
+  m.def("count_folds", &count_folds, py::arg("starts"), py::arg("ends"), py::arg("faces"), Release());
+}

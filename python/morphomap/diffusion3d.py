@@ -1,0 +1,75 @@
+"""Diffusion mapping in 3D: the Laplace problem in the shell between two closed surfaces."""
+
+from __future__ import annotations
+
+import numbers
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import _core
+from ._validate import as_flag
+from .surfaces import as_surface
+
+
+@dataclass(frozen=True)
+class ShellDiffusionSolution:
+    """The Laplace problem between two nested closed surfaces, solved.
+
+    vertices : (V, 3) float and tetrahedra : (T, 4) int64
+        The tetrahedral mesh of the shell (CGAL Mesh_3, positively oriented). Its boundary
+        approximates the surfaces; their vertices are not mesh vertices.
+    potential : (V,) float
+        c at the vertices: P1 finite elements with c = 1 on S1 and c = 0 on S2.
+    ends : (N, 3) float
+        For each vertex of S1, where its streamline of -grad c meets S2 (NaN if it does not).
+    streamlines : list of (K, 3) float
+        With ``streamlines=True``: the polyline of each streamline, from the vertex of S1 to its end.
+    seconds : dict
+        Wall-clock time of the stages: ``mesh``, ``solve`` and ``trace``.
+    """
+
+    vertices: np.ndarray
+    tetrahedra: np.ndarray
+    potential: np.ndarray
+    ends: np.ndarray
+    streamlines: list
+    seconds: dict
+
+
+def _mesh_size(value):
+    if value is None:
+        return 0.0
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"mesh_size: expected a number, got {type(value).__name__}")
+    value = float(value)
+    if not np.isfinite(value) or value <= 0:
+        raise ValueError(f"mesh_size: must be a finite number > 0, got {value}")
+    return value
+
+
+def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False) -> ShellDiffusionSolution:
+    """Solve Laplace's equation between S1 (c = 1) and S2 (c = 0) and trace the streamlines.
+
+    Parameters
+    ----------
+    s1, s2 : trimesh.Trimesh or (vertices, faces)
+        Closed, consistently oriented triangle surfaces, one inside the other (either way round).
+        Crossing surfaces are not supported yet.
+    mesh_size : float, optional
+        Largest tetrahedron size. Default: a quarter of the mean gap (the shell's volume over the
+        mean area of the surfaces). Near each surface the mesh follows its mean edge length (or
+        ``mesh_size`` if smaller) and grows by a tenth of the distance away from it.
+    streamlines : bool
+        Keep the polyline of each streamline.
+
+    Returns
+    -------
+    ShellDiffusionSolution
+        ``ends[i]`` is the image of vertex ``i`` of S1 on S2.
+    """
+    v1, f1 = as_surface(s1, "s1")
+    v2, f2 = as_surface(s2, "s2")
+    vertices, tetrahedra, potential, ends, lines, seconds = _core.solve_diffusion_3d(
+        v1, f1, v2, f2, _mesh_size(mesh_size), as_flag(streamlines, "streamlines"))
+    return ShellDiffusionSolution(vertices, tetrahedra, potential, ends, list(lines), dict(seconds))

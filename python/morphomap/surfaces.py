@@ -1,0 +1,142 @@
+"""Closed triangle surfaces (3D): queries, vertex normals and displacement fields between two."""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from . import _core
+from ._validate import as_choice, as_flag, as_points
+from .field import DisplacementField
+
+SURFACE_METHODS = ("minimal_distance", "normal", "diffusion", "auto")
+
+
+def as_faces(value, name: str, vertex_count: int) -> np.ndarray:
+    """Return ``value`` as a C-contiguous int64 (F, 3) array of indices into ``vertex_count`` vertices."""
+    if isinstance(value, (str, bytes)) or value is None:
+        raise TypeError(f"{name}: expected an integer array of shape (F, 3), got {type(value).__name__}")
+    try:
+        array = np.asarray(value)
+    except (ValueError, TypeError) as error:
+        raise ValueError(f"{name}: cannot be read as an array of shape (F, 3): {error}") from None
+    if array.dtype == bool or not np.issubdtype(array.dtype, np.integer):
+        if array.size == 0 and array.dtype == np.float64:  # an empty list
+            array = array.astype(np.int64)
+        else:
+            raise TypeError(f"{name}: expected integer vertex indices, got an array of dtype {array.dtype}")
+    if array.ndim != 2 or array.shape[1] != 3:
+        raise ValueError(f"{name}: expected shape (F, 3), got {array.shape}")
+    if array.size:
+        low, high = array.min(), array.max()
+        if low < 0 or high >= vertex_count:
+            bad = low if low < 0 else high
+            raise ValueError(f"{name}: vertex index {int(bad)} is outside 0..{vertex_count - 1}")
+    return np.ascontiguousarray(array, dtype=np.int64)
+
+
+def as_surface(value, name: str) -> tuple[np.ndarray, np.ndarray]:
+    """Return ``(vertices, faces)`` of a ``trimesh.Trimesh`` or a ``(vertices, faces)`` pair."""
+    if hasattr(value, "vertices") and hasattr(value, "faces") and not isinstance(value, (tuple, list)):
+        vertices, faces = value.vertices, value.faces
+    elif isinstance(value, (tuple, list)) and len(value) == 2:
+        vertices, faces = value
+    else:
+        raise TypeError(f"{name}: expected a trimesh.Trimesh or a (vertices, faces) pair, got {type(value).__name__}")
+    vertices = as_points(vertices, f"{name} vertices", 3)
+    return vertices, as_faces(faces, f"{name} faces", len(vertices))
+
+
+class SurfaceHits(NamedTuple):
+    """One row per query; NaN (faces: -1) where a line meets nothing.
+
+    points : (M, 3) float, the point found on the surface.
+    distances : (M,) float, Euclidean distance for closest points; for lines the signed distance
+        from the origin along the unit direction.
+    faces : (M,) int64, the triangle the point lies on.
+    """
+
+    points: np.ndarray
+    distances: np.ndarray
+    faces: np.ndarray
+
+
+class SurfaceIndex:
+    """A triangle surface prepared for many closest-point and line queries (Embree).
+
+    The triangles go into an Embree scene placed in a unit box; every answer is refined in double
+    precision on the original triangles. Queries run in C++ on all cores without the GIL. The
+    surface need not be closed.
+
+    Parameters
+    ----------
+    vertices : (V, 3) float
+    faces : (F, 3) int
+        Indices into ``vertices``; at least one face.
+    """
+
+    def __init__(self, vertices, faces):
+        vertices = as_points(vertices, "vertices", 3)
+        self._index = _core.SurfaceIndex(vertices, as_faces(faces, "faces", len(vertices)))
+
+    def closest_points(self, queries) -> SurfaceHits:
+        """Closest point on the surface to each query point (ties: the lowest face).
+
+        queries : (M, 3) float
+        """
+        return SurfaceHits(*self._index.closest_points(as_points(queries, "queries", 3)))
+
+    def line_intersections(self, origins, directions) -> SurfaceHits:
+        """Nearest intersection of each whole line ``origin + t * direction`` (t of either sign).
+
+        origins, directions : (M, 3) float; directions need not be unit, but not zero.
+        Ties in ``|t|`` go to the positive side, then to the lowest face.
+        """
+        origins = as_points(origins, "origins", 3)
+        directions = as_points(directions, "directions", 3)
+        return SurfaceHits(*self._index.line_intersections(origins, directions))
+
+
+def surface_normals(vertices, faces) -> np.ndarray:
+    """Unit normal at each vertex: the angle-weighted mean of the normals of its triangles.
+
+    vertices : (V, 3) float; faces : (F, 3) int. Returns (V, 3) float, outward on a closed surface
+    with consistently oriented faces; NaN at a vertex that no non-degenerate face uses.
+    """
+    vertices = as_points(vertices, "vertices", 3)
+    return _core.vertex_normals(vertices, as_faces(faces, "faces", len(vertices)))
+
+
+def map_surfaces(s1, s2, method="normal", *, reverse=False) -> DisplacementField:
+    """Map closed surface ``s1`` (time t) onto closed surface ``s2`` (time t + dt).
+
+    Parameters
+    ----------
+    s1, s2 : trimesh.Trimesh or (vertices (V, 3) float, faces (F, 3) int)
+        Closed, consistently oriented triangle surfaces: every edge used by exactly two faces in
+        opposite directions, finite coordinates, no zero-area face.
+    method : {"normal", "minimal_distance", "diffusion", "auto"}
+        ``"minimal_distance"``: each vertex of ``s1`` to its closest point on ``s2``.
+        ``"normal"``: the line through each vertex along its angle-weighted normal, both
+        directions, to its nearest intersection with ``s2``; NaN where it meets nothing.
+        ``"diffusion"``: streamlines of Laplace's equation in the region between the surfaces
+        (c = 1 on S1, 0 on S2) from each vertex to S2.
+        ``"auto"``: normal mapping; if a normal misses or a triangle's image is turned over (see
+        :func:`quality`, ``folds``), reverse diffusion for the whole surface instead (the field
+        then starts from the vertices of ``s2``; ``field.method`` tells).
+    reverse : bool
+        Map S2 -> S1 with the chosen algorithm and flip the vectors: starts lie on S1, ends on S2,
+        in the order of S2's vertices, and ``field.faces`` are S2's faces.
+
+    Returns
+    -------
+    DisplacementField
+        3D, with ``faces``: the connectivity of the start points.
+    """
+    method = as_choice(method, "method", SURFACE_METHODS)
+    reverse = as_flag(reverse, "reverse")
+    v1, f1 = as_surface(s1, "s1")
+    v2, f2 = as_surface(s2, "s2")
+    starts, ends, codes, faces = _core.map_surfaces(v1, f1, v2, f2, method, reverse)
+    return DisplacementField._from_core(starts, ends, codes, faces)

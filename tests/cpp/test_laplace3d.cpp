@@ -1,0 +1,191 @@
+// Diffusion mapping in 3D on shapes with a known answer: between concentric spheres the potential
+// is (1/r - 1/R) / (1/r0 - 1/R) and the streamlines are radial.
+#include <morphomap/errors.hpp>
+#include <morphomap/laplace3d.hpp>
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
+#include "check.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <utility>
+#include <vector>
+
+using morphomap::Faces;
+using morphomap::Index;
+using morphomap::InvalidInput;
+using morphomap::Points3;
+using morphomap::ShellDiffusionOptions;
+using morphomap::solve_diffusion_3d;
+
+namespace {
+
+struct Surface {
+  Points3 vertices;
+  Faces faces;
+};
+
+// Unit icosphere: the icosahedron with each triangle split in four `levels` times, outwards.
+Surface icosphere(int levels) {
+  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+  std::vector<Eigen::Vector3d> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                                    {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<std::array<Index, 3>> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                                         {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                         {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                                         {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+  for (auto& p : v) p.normalize();
+  for (int level = 0; level < levels; ++level) {
+    std::map<std::pair<Index, Index>, Index> middle;
+    auto mid = [&](Index a, Index b) {
+      const auto key = std::minmax(a, b);
+      const auto found = middle.find(key);
+      if (found != middle.end()) return found->second;
+      v.push_back((v[a] + v[b]).normalized());
+      return middle[key] = static_cast<Index>(v.size()) - 1;
+    };
+    std::vector<std::array<Index, 3>> next;
+    for (const auto& [a, b, c] : f) {
+      const Index ab = mid(a, b), bc = mid(b, c), ca = mid(c, a);
+      next.push_back({a, ab, ca});
+      next.push_back({b, bc, ab});
+      next.push_back({c, ca, bc});
+      next.push_back({ab, bc, ca});
+    }
+    f = std::move(next);
+  }
+  Surface s;
+  s.vertices.resize(static_cast<Index>(v.size()), 3);
+  for (std::size_t i = 0; i < v.size(); ++i) s.vertices.row(static_cast<Index>(i)) = v[i].transpose();
+  s.faces.resize(static_cast<Index>(f.size()), 3);
+  for (std::size_t i = 0; i < f.size(); ++i) s.faces.row(static_cast<Index>(i)) << f[i][0], f[i][1], f[i][2];
+  return s;
+}
+
+Surface scaled(Surface s, double x, double y, double z) {
+  s.vertices.col(0) *= x;
+  s.vertices.col(1) *= y;
+  s.vertices.col(2) *= z;
+  return s;
+}
+
+Surface flipped(Surface s) {
+  s.faces.col(1).swap(s.faces.col(2));
+  return s;
+}
+
+// RMS angle between the directions of starts and ends, times the radius r of the end sphere.
+double radial_rms(const Points3& starts, const Points3& ends, double r) {
+  double sum = 0.0;
+  for (Index i = 0; i < starts.rows(); ++i) {
+    const Eigen::Vector3d a = starts.row(i).transpose(), b = ends.row(i).transpose();
+    const double angle = std::atan2(a.cross(b).norm(), a.dot(b));
+    sum += angle * angle;
+  }
+  return r * std::sqrt(sum / starts.rows());
+}
+
+void concentric_spheres() {
+  const Surface inner = scaled(icosphere(3), 1, 1, 1), outer = scaled(icosphere(3), 4, 4, 4);
+  ShellDiffusionOptions options;
+  options.keep_streamlines = true;
+  const auto solution = solve_diffusion_3d(inner.vertices, inner.faces, outer.vertices, outer.faces, options);
+  CHECK(solution.ends.rows() == inner.vertices.rows());
+  CHECK(solution.ends.allFinite());
+  const double rms = radial_rms(inner.vertices, solution.ends, 4.0);
+  std::printf("spheres 1 -> 4: %lld tetrahedra, RMS end error %.2e, %.2f s mesh, %.2f s solve, %.2f s trace\n",
+              static_cast<long long>(solution.tetrahedra.rows()), rms, solution.seconds.mesh,
+              solution.seconds.solve, solution.seconds.trace);
+  CHECK(rms < 0.03);  // level-3 spheres; tests/test_diffusion3d.py holds level 4 to 0.01
+  // The ends lie on the target, a polyhedron inscribed in the sphere of radius 4.
+  for (Index i = 0; i < solution.ends.rows(); ++i) {
+    CHECK(solution.ends.row(i).norm() <= 4.0 + 1e-9);
+    CHECK(solution.ends.row(i).norm() > 3.97);
+  }
+  // Potential against the exact one, inside the shell (the mesh boundary is within facet_distance).
+  double worst = 0.0;
+  for (Index v = 0; v < solution.vertices.rows(); ++v) {
+    const double r = solution.vertices.row(v).norm();
+    const double exact = (1.0 / r - 0.25) / 0.75;
+    worst = std::max(worst, std::abs(solution.potential[v] - std::clamp(exact, 0.0, 1.0)));
+  }
+  std::printf("spheres 1 -> 4: largest potential error %.2e\n", worst);
+  CHECK(worst < 0.02);
+  CHECK(solution.streamlines.size() == static_cast<std::size_t>(inner.vertices.rows()));
+  CHECK(solution.streamlines[0].rows() >= 3);
+  CHECK((solution.streamlines[0].row(0) - inner.vertices.row(0)).norm() == 0.0);
+  CHECK((solution.streamlines[0].bottomRows(1) - solution.ends.row(0)).norm() == 0.0);
+  // Tetrahedra positively oriented, with volume adding up to the shell (the mesh's approximation).
+  double volume = 0.0;
+  for (Index t = 0; t < solution.tetrahedra.rows(); ++t) {
+    Eigen::Matrix3d e;
+    for (int i = 0; i < 3; ++i) {
+      e.col(i) = (solution.vertices.row(solution.tetrahedra(t, i + 1)) - solution.vertices.row(solution.tetrahedra(t, 0))).transpose();
+    }
+    CHECK(e.determinant() > 0.0);
+    volume += e.determinant() / 6.0;
+  }
+  const double pi = std::acos(-1.0);
+  CHECK_NEAR(volume, 4.0 / 3.0 * pi * (64.0 - 1.0), 0.03 * 4.0 / 3.0 * pi * 63.0);
+}
+
+// The outer surface as source: streamlines run inwards; face orientation does not matter.
+void inwards_and_flipped() {
+  const Surface inner = flipped(scaled(icosphere(3), 1, 1, 1)), outer = scaled(icosphere(2), 3, 3, 3);
+  const auto solution = solve_diffusion_3d(outer.vertices, outer.faces, inner.vertices, inner.faces);
+  CHECK(solution.ends.allFinite());
+  const double rms = radial_rms(outer.vertices, solution.ends, 1.0);
+  std::printf("spheres 3 -> 1: RMS end error %.2e\n", rms);
+  CHECK(rms < 0.01);
+}
+
+// Sphere onto an ellipsoid: every streamline arrives.
+void sphere_to_ellipsoid() {
+  const Surface sphere = icosphere(3), ellipsoid = scaled(icosphere(3), 2.0, 1.5, 1.2);
+  const auto solution = solve_diffusion_3d(sphere.vertices, sphere.faces, ellipsoid.vertices, ellipsoid.faces);
+  CHECK(solution.ends.allFinite());
+  for (Index i = 0; i < solution.ends.rows(); ++i) {
+    const Eigen::RowVector3d q = solution.ends.row(i);
+    CHECK_NEAR(q.cwiseQuotient(Eigen::RowVector3d(2.0, 1.5, 1.2)).norm(), 1.0, 0.01);
+  }
+}
+
+void bad_input() {
+  const Surface a = icosphere(1), b = scaled(icosphere(1), 3, 3, 3);
+  Surface apart = a;
+  apart.vertices.col(0).array() += 5.0;
+  CHECK_THROWS(solve_diffusion_3d(a.vertices, a.faces, apart.vertices, apart.faces), InvalidInput);
+  Surface crossing = a;
+  crossing.vertices.col(0).array() += 0.5;
+  CHECK_THROWS(solve_diffusion_3d(a.vertices, a.faces, crossing.vertices, crossing.faces), InvalidInput);
+  Surface open = b;
+  open.faces.conservativeResize(open.faces.rows() - 1, 3);
+  CHECK_THROWS(solve_diffusion_3d(a.vertices, a.faces, open.vertices, open.faces), InvalidInput);
+  Surface inconsistent = b;
+  inconsistent.faces.row(0) = inconsistent.faces.row(0).reverse().eval();
+  CHECK_THROWS(solve_diffusion_3d(a.vertices, a.faces, inconsistent.vertices, inconsistent.faces), InvalidInput);
+  Surface out_of_range = a;
+  out_of_range.faces(0, 0) = out_of_range.vertices.rows();
+  CHECK_THROWS(solve_diffusion_3d(out_of_range.vertices, out_of_range.faces, b.vertices, b.faces), InvalidInput);
+  Surface not_finite = a;
+  not_finite.vertices(0, 0) = std::nan("");
+  CHECK_THROWS(solve_diffusion_3d(not_finite.vertices, not_finite.faces, b.vertices, b.faces), InvalidInput);
+  ShellDiffusionOptions negative;
+  negative.mesh_size = -1.0;
+  CHECK_THROWS(solve_diffusion_3d(a.vertices, a.faces, b.vertices, b.faces, negative), InvalidInput);
+}
+
+}  // namespace
+
+int main() {
+  bad_input();
+  concentric_spheres();
+  inwards_and_flipped();
+  sphere_to_ellipsoid();
+  TEST_MAIN_END();
+}

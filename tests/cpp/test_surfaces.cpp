@@ -1,0 +1,187 @@
+// Surface queries and mapping on spheres and ellipsoids, against brute force and closed forms.
+#include <morphomap/morphomap.hpp>
+
+#include <Eigen/Geometry>
+
+#include <array>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <random>
+#include <utility>
+
+#include "check.hpp"
+
+using namespace morphomap;
+
+namespace {
+
+struct Mesh {
+  Points3 vertices;
+  Faces faces;
+};
+
+// An octahedron subdivided `levels` times and pushed onto the unit sphere; outward faces.
+Mesh unit_sphere(int levels) {
+  std::vector<Eigen::Vector3d> v = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  std::vector<std::array<Index, 3>> f = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                                         {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  for (int l = 0; l < levels; ++l) {
+    std::map<std::pair<Index, Index>, Index> middle;
+    auto mid = [&](Index a, Index b) {
+      const auto key = std::minmax(a, b);
+      auto it = middle.find(key);
+      if (it != middle.end()) return it->second;
+      v.push_back((v[a] + v[b]).normalized());
+      return middle[key] = static_cast<Index>(v.size()) - 1;
+    };
+    std::vector<std::array<Index, 3>> next;
+    for (const auto& t : f) {
+      const Index ab = mid(t[0], t[1]), bc = mid(t[1], t[2]), ca = mid(t[2], t[0]);
+      next.push_back({t[0], ab, ca});
+      next.push_back({ab, t[1], bc});
+      next.push_back({ca, bc, t[2]});
+      next.push_back({ab, bc, ca});
+    }
+    f = std::move(next);
+  }
+  Mesh m;
+  m.vertices.resize(v.size(), 3);
+  for (std::size_t i = 0; i < v.size(); ++i) m.vertices.row(i) = v[i].normalized().transpose();
+  m.faces.resize(f.size(), 3);
+  for (std::size_t j = 0; j < f.size(); ++j) m.faces.row(j) << f[j][0], f[j][1], f[j][2];
+  return m;
+}
+
+Mesh scaled(Mesh m, double a, double b, double c) {
+  m.vertices.col(0) *= a, m.vertices.col(1) *= b, m.vertices.col(2) *= c;
+  return m;
+}
+
+// Nearest intersection of a line with any triangle, by testing all of them.
+double brute_line(const Mesh& m, const Eigen::Vector3d& o, const Eigen::Vector3d& u) {
+  double best = std::numeric_limits<double>::quiet_NaN();
+  for (Index j = 0; j < m.faces.rows(); ++j) {
+    const Eigen::Vector3d a = m.vertices.row(m.faces(j, 0)), b = m.vertices.row(m.faces(j, 1)),
+                          c = m.vertices.row(m.faces(j, 2));
+    const Eigen::Vector3d e1 = b - a, e2 = c - a, p = u.cross(e2);
+    const double det = e1.dot(p);
+    if (det == 0) continue;
+    const Eigen::Vector3d s = o - a, q = s.cross(e1);
+    const double bu = s.dot(p) / det, bv = u.dot(q) / det, t = e2.dot(q) / det;
+    if (bu < 0 || bv < 0 || bu + bv > 1) continue;
+    if (std::isnan(best) || std::abs(t) < std::abs(best)) best = t;
+  }
+  return best;
+}
+
+}  // namespace
+
+int main() {
+  const Mesh sphere = unit_sphere(4);   // 2048 faces
+  const Mesh ellipsoid = scaled(unit_sphere(5), 2.0, 1.5, 1.2);
+
+  // Checks of a closed surface.
+  CHECK_NEAR(check_closed_surface(sphere.vertices, sphere.faces, "s1"), 4.0 / 3.0 * M_PI, 0.05);
+  {
+    Faces open = sphere.faces.topRows(sphere.faces.rows() - 1);
+    CHECK_THROWS(check_closed_surface(sphere.vertices, open, "s1"), InvalidInput);
+    Faces flipped = sphere.faces;
+    std::swap(flipped(7, 0), flipped(7, 1));
+    CHECK_THROWS(check_closed_surface(sphere.vertices, flipped, "s1"), InvalidInput);
+    Points3 nan = sphere.vertices;
+    nan(3, 1) = std::nan("");
+    CHECK_THROWS(check_closed_surface(nan, sphere.faces, "s1"), InvalidInput);
+    Faces out = sphere.faces;
+    out(0, 0) = sphere.vertices.rows();
+    CHECK_THROWS(check_closed_surface(sphere.vertices, out, "s1"), InvalidInput);
+    try {
+      check_closed_surface(sphere.vertices, open, "s2");
+      CHECK(false);
+    } catch (const InvalidInput& e) {
+      CHECK(std::string(e.what()).rfind("s2: ", 0) == 0);
+    }
+  }
+
+  // Vertex normals of the sphere point outwards along the radius.
+  const Points3 normals = vertex_normals(sphere.vertices, sphere.faces);
+  double worst = 0;
+  for (Index i = 0; i < normals.rows(); ++i) worst = std::max(worst, (normals.row(i) - sphere.vertices.row(i)).norm());
+  CHECK(worst < 0.02);
+
+  // Lines and closest points against brute force.
+  std::mt19937_64 rng(20141);
+  std::uniform_real_distribution<double> uniform(-2.5, 2.5);
+  std::normal_distribution<double> gauss;
+  const Index q = 400;
+  Points3 origins(q, 3), directions(q, 3);
+  for (Index i = 0; i < q; ++i) {
+    origins.row(i) << uniform(rng), uniform(rng), uniform(rng);
+    directions.row(i) << gauss(rng), gauss(rng), gauss(rng);
+  }
+  const SurfaceIndex index(ellipsoid.vertices, ellipsoid.faces);
+  const SurfaceHits lines = index.line_intersections(origins, directions);
+  int hits = 0;
+  for (Index i = 0; i < q; ++i) {
+    const Eigen::Vector3d u = directions.row(i).normalized();
+    const double expected = brute_line(ellipsoid, origins.row(i), u);
+    CHECK(std::isnan(expected) == std::isnan(lines.distances[i]));
+    if (!std::isnan(expected)) {
+      ++hits;
+      CHECK_NEAR(lines.distances[i], expected, 1e-9 * 4.0);
+      CHECK(lines.faces[i] >= 0);
+    } else {
+      CHECK(lines.faces[i] == -1);
+    }
+  }
+  CHECK(hits > q / 4);
+  const SurfaceHits near = index.closest_points(origins);
+  for (Index i = 0; i < q; ++i) {
+    double best = std::numeric_limits<double>::infinity();
+    const Index f = near.faces[i];
+    CHECK(f >= 0);
+    // No vertex is nearer than the point found (tests/test_surfaces.py compares with brute force).
+    for (Index v = 0; v < ellipsoid.vertices.rows(); ++v) {
+      best = std::min(best, (ellipsoid.vertices.row(v) - origins.row(i)).norm());
+    }
+    CHECK(near.distances[i] <= best + 1e-15);
+    CHECK_NEAR(near.distances[i], (near.points.row(i) - origins.row(i)).norm(), 1e-14);
+  }
+
+  // Mapping the sphere onto the ellipsoid.
+  SurfaceMappingOptions options;
+  options.method = MapMethod::normal;
+  const DisplacementField3 normal = map_surfaces(sphere.vertices, sphere.faces, ellipsoid.vertices, ellipsoid.faces, options);
+  CHECK(normal.size() == sphere.vertices.rows());
+  CHECK(normal.faces == sphere.faces);
+  for (Index i = 0; i < normal.size(); ++i) CHECK(normal.valid(i));
+  CHECK(count_folds(normal.starts, normal.ends, normal.faces) == 0);
+  const SurfaceQuality qn = quality(normal, sphere.vertices, sphere.faces, ellipsoid.vertices, ellipsoid.faces);
+  CHECK(qn.folds == 0);
+  CHECK(std::isfinite(qn.qm1) && std::isfinite(qn.qm2) && qn.qm1 < 0.5);
+
+  options.method = MapMethod::minimal_distance;
+  const DisplacementField3 md = map_surfaces(sphere.vertices, sphere.faces, ellipsoid.vertices, ellipsoid.faces, options);
+  const SurfaceQuality qmd = quality(md, sphere.vertices, sphere.faces, ellipsoid.vertices, ellipsoid.faces);
+  CHECK(qmd.qm1 > qn.qm1);
+
+  // Identity: every vector has zero length, every ratio is one.
+  const DisplacementField3 same = map_surfaces(sphere.vertices, sphere.faces, sphere.vertices, sphere.faces, options);
+  CHECK_NEAR((same.ends - same.starts).cwiseAbs().maxCoeff(), 0.0, 1e-15);
+  const SurfaceQuality qs = quality(same, sphere.vertices, sphere.faces, sphere.vertices, sphere.faces);
+  CHECK_NEAR(qs.qm1, 0.0, 1e-24);
+  CHECK(std::isnan(qs.qm2));  // every swept volume is zero
+
+  // Reverse: starts on the sphere, ends at the ellipsoid's vertices, in the ellipsoid's order.
+  options.method = MapMethod::normal;
+  options.reverse = true;
+  const DisplacementField3 back = map_surfaces(sphere.vertices, sphere.faces, ellipsoid.vertices, ellipsoid.faces, options);
+  CHECK(back.size() == ellipsoid.vertices.rows());
+  CHECK(back.faces == ellipsoid.faces);
+  CHECK((back.ends - ellipsoid.vertices).cwiseAbs().maxCoeff() == 0.0);
+  for (Index i = 0; i < back.size(); ++i) CHECK(std::abs(back.starts.row(i).norm() - 1.0) < 0.01);
+
+  options.method = MapMethod::uniform;
+  CHECK_THROWS(map_surfaces(sphere.vertices, sphere.faces, ellipsoid.vertices, ellipsoid.faces, options), InvalidInput);
+  TEST_MAIN_END();
+}

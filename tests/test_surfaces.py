@@ -1,0 +1,387 @@
+"""Surfaces in 3D: Embree queries against brute force and closed forms, and surface mapping."""
+
+import threading
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from hypothesis.extra import numpy as hnp
+
+import morphomap as mm
+
+AXES = np.array([2.0, 1.5, 1.2])  # the ellipsoid of the paper's Figure 12
+
+
+def icosphere(subdivisions, radius=1.0):
+    """An icosahedron subdivided ``subdivisions`` times onto the sphere; outward faces."""
+    g = (1 + 5**0.5) / 2
+    v = [[-1, g, 0], [1, g, 0], [-1, -g, 0], [1, -g, 0], [0, -1, g], [0, 1, g],
+         [0, -1, -g], [0, 1, -g], [g, 0, -1], [g, 0, 1], [-g, 0, -1], [-g, 0, 1]]
+    f = [[0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4],
+         [11, 10, 2], [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8],
+         [3, 8, 9], [4, 9, 5], [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1]]
+    vertices = [np.array(p, float) / np.linalg.norm(p) for p in v]
+    faces = np.array(f)
+    for _ in range(subdivisions):
+        middle = {}
+
+        def mid(a, b):
+            key = (min(a, b), max(a, b))
+            if key not in middle:
+                p = vertices[a] + vertices[b]
+                vertices.append(p / np.linalg.norm(p))
+                middle[key] = len(vertices) - 1
+            return middle[key]
+
+        out = []
+        for a, b, c in faces:
+            ab, bc, ca = mid(a, b), mid(b, c), mid(c, a)
+            out += [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]
+        faces = np.array(out)
+    return radius * np.array(vertices), faces.astype(np.int64)
+
+
+def ellipsoid(subdivisions):
+    v, f = icosphere(subdivisions)
+    return v * AXES, f
+
+
+def face_areas(v, f):
+    return 0.5 * np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1)
+
+
+def brute_lines(v, f, origins, directions):
+    """Nearest |t| intersection of each whole line with all triangles (Moller-Trumbore, float64),
+    and whether a hit on the other side is as near to within 1e-12 (a tie that rounding decides)."""
+    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    e1, e2 = b - a, c - a
+    out = np.full(len(origins), np.nan)
+    tie = np.zeros(len(origins), bool)
+    for i, (o, d) in enumerate(zip(origins, directions)):
+        u = d / np.linalg.norm(d)
+        p = np.cross(u, e2)
+        det = np.einsum("ij,ij->i", e1, p)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            s = o - a
+            bu = np.einsum("ij,ij->i", s, p) / det
+            q = np.cross(s, e1)
+            bv = q @ u / det
+            t = np.einsum("ij,ij->i", e2, q) / det
+        # Inclusive by 1e-12: without slack, rounding lets a line through a vertex or an edge slip
+        # between the triangles around it (Moller-Trumbore is not watertight).
+        ok = (det != 0) & (bu >= -1e-12) & (bv >= -1e-12) & (bu + bv <= 1 + 1e-12)
+        if ok.any():
+            t = t[ok]
+            out[i] = t[np.argmin(np.abs(t))]
+            tie[i] = (np.abs(np.abs(t[np.sign(t) != np.sign(out[i])]) - abs(out[i])) < 1e-12).any()
+    return out, tie
+
+
+def brute_closest(v, f, queries):
+    """Distance from each query to the nearest triangle: in the face's plane when the projection
+    is inside it, else to the nearest edge (float64, all triangles)."""
+    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    n = np.cross(b - a, c - a)
+    n /= np.linalg.norm(n, axis=1)[:, None]
+
+    def segment(p, x, y):
+        d = y - x
+        t = np.clip(np.einsum("ij,ij->i", p - x, d) / np.einsum("ij,ij->i", d, d), 0, 1)
+        return np.linalg.norm(p - (x + t[:, None] * d), axis=1)
+
+    out = np.empty(len(queries))
+    for i, p in enumerate(queries):
+        h = np.einsum("ij,ij->i", p - a, n)
+        x = p - h[:, None] * n
+        inside = np.ones(len(f), bool)
+        for s, t in ((a, b), (b, c), (c, a)):
+            inside &= np.einsum("ij,ij->i", np.cross(t - s, x - s), n) >= 0
+        d = np.minimum.reduce([segment(p, a, b), segment(p, b, c), segment(p, c, a)])
+        out[i] = np.where(inside, np.abs(h), d).min()
+    return out
+
+
+@pytest.fixture(scope="module")
+def sphere():
+    return icosphere(4)  # radius 1, 5120 faces
+
+
+@pytest.fixture(scope="module")
+def fine_ellipsoid():
+    return ellipsoid(6)  # 81920 faces
+
+
+def random_lines(rng, q):
+    return rng.uniform(-2.5, 2.5, (q, 3)), rng.normal(size=(q, 3))
+
+
+def test_line_intersections_equal_brute_force(rng):
+    v, f = ellipsoid(5)
+    origins, directions = random_lines(rng, 300)
+    # Lines through the centre and vertices make ties and edge hits likely.
+    origins[:50] = 0.0
+    directions[50:100] = v[rng.choice(len(v), 50)] - origins[50:100]
+    hits = mm.SurfaceIndex(v, f).line_intersections(origins, directions)
+    expected, tie = brute_lines(v, f, origins, directions)
+    assert np.array_equal(np.isnan(hits.distances), np.isnan(expected))
+    found = ~np.isnan(expected)
+    assert found.sum() > 150
+    assert tie[:50].all()  # the ellipsoid mesh is symmetric about its centre
+    size = np.ptp(v, axis=0).max()
+    assert np.abs(np.abs(hits.distances[found]) - np.abs(expected[found])).max() <= 1e-9 * size
+    signed = found & ~tie
+    assert np.abs(hits.distances[signed] - expected[signed]).max() <= 1e-9 * size
+    u = directions / np.linalg.norm(directions, axis=1)[:, None]
+    np.testing.assert_allclose(hits.points[found], origins[found] + hits.distances[found, None] * u[found],
+                               atol=1e-12 * size)
+    assert (hits.faces[found] >= 0).all() and (hits.faces[~found] == -1).all()
+    assert np.isnan(hits.points[~found]).all()
+
+
+def test_closest_points_equal_brute_force(rng):
+    v, f = ellipsoid(4)
+    queries = rng.uniform(-2.5, 2.5, (300, 3))
+    queries[:20] = v[:20]  # on the surface
+    hits = mm.SurfaceIndex(v, f).closest_points(queries)
+    expected = brute_closest(v, f, queries)
+    assert np.abs(hits.distances - expected).max() <= 1e-12
+    np.testing.assert_allclose(np.linalg.norm(hits.points - queries, axis=1), hits.distances, atol=1e-14)
+    # The point lies on the face reported.
+    a, b, c = (v[f[hits.faces, k]] for k in range(3))
+    n = np.cross(b - a, c - a)
+    assert np.abs(np.einsum("ij,ij->i", hits.points - a, n / np.linalg.norm(n, axis=1)[:, None])).max() < 1e-12
+
+
+def test_surface_normals_of_a_sphere(sphere):
+    v, f = sphere
+    normals = mm.surface_normals(v, f)
+    np.testing.assert_allclose(np.linalg.norm(normals, axis=1), 1.0, atol=1e-15)
+    assert np.linalg.norm(normals - v, axis=1).max() < 1e-2  # nearly radial on a regular mesh
+
+
+def test_normal_mapping_hits_the_analytic_ellipsoid(sphere, fine_ellipsoid):
+    v1, f1 = sphere
+    v2, f2 = fine_ellipsoid
+    field = mm.map_surfaces((v1, f1), (v2, f2), "normal")
+    assert field.dim == 3 and len(field) == len(v1) and field.valid.all()
+    np.testing.assert_array_equal(field.faces, f1)
+    assert set(field.method) == {"normal"}
+    # The same lines against the exact ellipsoid x^T D x = 1: the nearer root of the quadratic.
+    o, u = v1, mm.surface_normals(v1, f1)
+    w = 1 / AXES**2
+    qa, qb, qc = (u * u) @ w, 2 * (o * u) @ w, (o * o) @ w - 1
+    roots = np.stack([(-qb + s * np.sqrt(qb * qb - 4 * qa * qc)) / (2 * qa) for s in (1, -1)], axis=1)
+    t = roots[np.arange(len(o)), np.argmin(np.abs(roots), axis=1)]
+    exact = o + t[:, None] * u
+    error = np.linalg.norm(field.ends - exact, axis=1)
+    # Bound: every vertex lies on the ellipsoid, so a triangle of circumradius R deviates from it by
+    # at most the sagitta kappa R^2 / 2 (to first order; kappa = the largest principal curvature,
+    # a / c^2 at the tips of the long axis). Along a line at angle theta to the ellipsoid's normal
+    # this distance becomes sagitta / cos(theta). Factor 1.2 for the second-order terms.
+    a, b, c = (v2[f2[:, k]] for k in range(3))
+    la, lb, lc = (np.linalg.norm(x - y, axis=1) for x, y in ((b, c), (c, a), (a, b)))
+    circumradius = (la * lb * lc / (4 * face_areas(v2, f2))).max()
+    kappa = AXES.max() / AXES.min() ** 2
+    normal = exact * w
+    cos = np.abs(np.einsum("ij,ij->i", normal / np.linalg.norm(normal, axis=1)[:, None], u))
+    bound = 1.2 * kappa * circumradius**2 / 2 / cos
+    assert (error <= bound).all(), (error.max(), bound.min())
+    assert error.max() < 2e-3  # 81920 faces: R ~ 0.02 on the long axis
+
+
+def unreached_fraction(ends, v2, f2):
+    """Area fraction of S2 that no end point reaches: faces with no end point on a face of their
+    1-ring (the faces sharing a vertex with them)."""
+    on = mm.SurfaceIndex(v2, f2).closest_points(ends[np.isfinite(ends).all(axis=1)]).faces
+    hit_vertex = np.zeros(len(v2), bool)
+    hit_vertex[f2[on].ravel()] = True  # vertices of faces holding an end point
+    reached = hit_vertex[f2].any(axis=1)
+    areas = face_areas(v2, f2)
+    return areas[~reached].sum() / areas.sum()
+
+
+def test_sphere_onto_ellipsoid_minimal_distance_leaves_regions_unreached(sphere):
+    v1, f1 = sphere
+    v2, f2 = ellipsoid(4)
+    md = mm.map_surfaces((v1, f1), (v2, f2), "minimal_distance")
+    normal = mm.map_surfaces((v1, f1), (v2, f2), "normal")
+    lost_md = unreached_fraction(md.ends, v2, f2)
+    lost_normal = unreached_fraction(normal.ends, v2, f2)
+    print(f"unreached area: minimal distance {lost_md:.3f}, normal {lost_normal:.4f}")
+    assert lost_md > 0.15
+    assert lost_normal < 0.01
+    qn = mm.quality(normal, (v1, f1), (v2, f2))
+    qmd = mm.quality(md, (v1, f1), (v2, f2))
+    assert isinstance(qn, mm.SurfaceQuality)
+    assert qn.folds == 0
+    assert qn.qm1 < qmd.qm1
+
+
+def test_minimal_distance_ends_on_the_target(sphere):
+    v1, f1 = sphere
+    v2, f2 = ellipsoid(3)
+    field = mm.map_surfaces((v1, f1), (v2, f2), "minimal_distance")
+    hits = mm.SurfaceIndex(v2, f2).closest_points(v1)
+    np.testing.assert_array_equal(field.ends, hits.points)
+
+
+def test_reverse_starts_on_s1_in_s2_order(sphere):
+    v1, f1 = sphere
+    v2, f2 = ellipsoid(3)
+    field = mm.map_surfaces((v1, f1), (v2, f2), "normal", reverse=True)
+    assert len(field) == len(v2)
+    np.testing.assert_array_equal(field.ends, v2)
+    np.testing.assert_array_equal(field.faces, f2)
+    assert np.abs(np.linalg.norm(field.starts, axis=1) - 1).max() < 0.01  # on the sphere mesh
+
+
+def test_quality_of_the_identity_and_a_scaling(sphere):
+    v, f = sphere
+    same = mm.map_surfaces((v, f), (v, f), "minimal_distance")
+    q = mm.quality(same, (v, f), (v, f))
+    assert q.qm1 == pytest.approx(0.0, abs=1e-24) and q.folds == 0 and np.isnan(q.qm2)
+    # Normal mapping onto a concentric sphere of radius 2 scales every triangle by 4 = alpha.
+    big = mm.map_surfaces((v, f), (2 * v, f), "normal")
+    q = mm.quality(big, (v, f), (2 * v, f))
+    # (The vertex normals are not exactly radial, so the images are not exactly 2 p.)
+    assert q.qm1 < 1e-3 and q.folds == 0
+    # With images exactly 2 p the solid is a frustum of the cone from the centre (planar sides, so
+    # the three tetrahedra fill it exactly): V_j = (8 - 1) |det(p0, p1, p2)| / 6.
+    exact = mm.quality(mm.DisplacementField(v, 2 * v, "normal", f), (v, f), (2 * v, f))
+    volume = 7 * np.abs(np.linalg.det(v[f])) / 6
+    assert exact.qm1 == pytest.approx(0.0, abs=1e-24) and exact.folds == 0
+    assert exact.qm2 == pytest.approx(np.mean((volume / volume.mean() - 1) ** 2), rel=1e-9)
+    assert exact.qm == 0.0
+
+
+def test_folds_count_turned_over_images(sphere):
+    v, f = sphere
+    field = mm.map_surfaces((v, f), (v, f), "minimal_distance")
+    ends = field.ends * [1, 1, -1]  # a mirror: turns over the triangles facing up or down
+    mirrored = mm.DisplacementField(field.starts, ends, field.method, f)
+    n = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    image = np.cross(ends[f[:, 1]] - ends[f[:, 0]], ends[f[:, 2]] - ends[f[:, 0]])
+    expected = int((np.einsum("ij,ij->i", n, image) < 0).sum())
+    assert 0 < expected < len(f)
+    assert mm.quality(mirrored, (v, f), (v * [1, 1, -1], f[:, ::-1])).folds == expected
+
+
+def test_trimesh_input(sphere):
+    trimesh = pytest.importorskip("trimesh")
+    s1 = trimesh.creation.icosphere(subdivisions=3)
+    s2 = trimesh.Trimesh(*ellipsoid(3))
+    field = mm.map_surfaces(s1, s2)
+    assert field.valid.all() and len(field) == len(s1.vertices)
+    q = mm.quality(field, s1, s2)
+    assert q.folds == 0
+
+
+def test_auto_is_normal_when_it_works(sphere):
+    v1, f1 = sphere
+    field = mm.map_surfaces((v1, f1), ellipsoid(3), "auto")
+    assert set(field.method) == {"normal"}
+
+
+def test_auto_falls_back_to_reverse_diffusion_where_normals_miss(sphere):
+    # Most normals of a big sphere miss a small one off its centre; "auto" then takes reverse
+    # diffusion: streamlines from the small sphere's vertices back to the big one, turned round.
+    v1, f1 = icosphere(2, radius=3.0)
+    v2, f2 = icosphere(2, radius=0.5)
+    v2 = v2 + [1.0, 0, 0]
+    assert not mm.map_surfaces((v1, f1), (v2, f2), "normal").valid.all()
+    field = mm.map_surfaces((v1, f1), (v2, f2), "auto")
+    assert set(field.method) == {"diffusion"}
+    assert len(field) == len(v2)
+    np.testing.assert_array_equal(field.faces, f2)
+    valid = field.valid
+    assert valid.mean() > 0.9
+    np.testing.assert_array_equal(field.ends[valid], v2[valid])
+
+
+# ---- bad input ------------------------------------------------------------------------------
+
+
+def test_open_flipped_nan_and_out_of_range(sphere):
+    v, f = sphere
+    good = (v, f)
+    with pytest.raises(ValueError, match=r"^s1: .*not closed"):
+        mm.map_surfaces((v, f[:-1]), good)
+    flipped = f.copy()
+    flipped[5] = flipped[5, ::-1]
+    with pytest.raises(ValueError, match=r"^s2: .*same direction"):
+        mm.map_surfaces(good, (v, flipped))
+    bad = v.copy()
+    bad[7, 2] = np.nan
+    with pytest.raises(ValueError, match=r"^s1 vertices: row 7"):
+        mm.map_surfaces((bad, f), good)
+    out = f.copy()
+    out[3, 1] = len(v)
+    with pytest.raises(ValueError, match=r"^s2 faces: vertex index"):
+        mm.map_surfaces(good, (v, out))
+    with pytest.raises(ValueError, match=r"^s2 faces: vertex index -1"):
+        mm.map_surfaces(good, (v, f - 1))
+    zero = v.copy()
+    zero[f[0, 1]] = zero[f[0, 0]]
+    with pytest.raises(ValueError, match=r"^s1: "):
+        mm.map_surfaces((zero, f), good)
+
+
+def test_wrong_types_and_shapes(sphere):
+    v, f = sphere
+    good = (v, f)
+    with pytest.raises(TypeError, match="^s1: "):
+        mm.map_surfaces(v, good)
+    with pytest.raises(TypeError, match="^s2 faces: "):
+        mm.map_surfaces(good, (v, f.astype(float)))
+    with pytest.raises(ValueError, match=r"^s1 vertices: expected shape \(N, 3\)"):
+        mm.map_surfaces((v[:, :2], f), good)
+    with pytest.raises(ValueError, match=r"^s1 faces: expected shape \(F, 3\)"):
+        mm.map_surfaces((v, f[:, :2]), good)
+    with pytest.raises(ValueError, match="^method: "):
+        mm.map_surfaces(good, good, "uniform")
+    with pytest.raises(TypeError, match="^reverse: "):
+        mm.map_surfaces(good, good, reverse=1)
+    with pytest.raises(ValueError, match="^directions: row 1 is the zero vector"):
+        mm.SurfaceIndex(v, f).line_intersections(np.zeros((2, 3)), np.array([[1.0, 0, 0], [0, 0, 0]]))
+    with pytest.raises(ValueError, match="^faces: the surface has no face"):
+        mm.SurfaceIndex(v, np.zeros((0, 3), np.int64))
+    with pytest.raises(ValueError, match="^queries: "):
+        mm.SurfaceIndex(v, f).closest_points(np.full((1, 3), np.inf))
+    with pytest.raises(ValueError, match="^field: "):
+        mm.quality(mm.DisplacementField(v, v, "normal"), good, good)
+
+
+def test_queries_release_the_gil(rng):
+    v, f = ellipsoid(5)
+    index = mm.SurfaceIndex(v, f)
+    origins, directions = random_lines(rng, 200_000)
+    threads = [threading.Thread(target=index.line_intersections, args=(origins, directions)) for _ in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+
+
+finite = st.floats(-1e3, 1e3, allow_nan=False, width=64)
+anything = st.floats(allow_nan=True, allow_infinity=True, width=64)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    vertices=hnp.arrays(np.float64, st.tuples(st.integers(0, 12), st.integers(2, 4)), elements=anything),
+    faces=hnp.arrays(np.int64, st.tuples(st.integers(0, 12), st.integers(2, 4)), elements=st.integers(-2, 14)),
+    queries=hnp.arrays(np.float64, st.tuples(st.integers(0, 5), st.just(3)), elements=finite),
+)
+def test_random_arrays_never_crash(vertices, faces, queries):
+    for call in (
+        lambda: mm.map_surfaces((vertices, faces), (vertices, faces)),
+        lambda: mm.map_surfaces((vertices, faces), (vertices, faces), "minimal_distance"),
+        lambda: mm.SurfaceIndex(vertices, faces).closest_points(queries),
+        lambda: mm.SurfaceIndex(vertices, faces).line_intersections(queries, queries + 1),
+        lambda: mm.surface_normals(vertices, faces),
+    ):
+        try:
+            call()
+        except (ValueError, TypeError):
+            pass
