@@ -3,6 +3,7 @@
 #include <morphomap/curve_queries.hpp>
 #include <morphomap/errors.hpp>
 #include <morphomap/laplace.hpp>
+#include <morphomap/transform.hpp>
 
 #include "region_mesh.hpp"
 #include "validation.hpp"
@@ -298,10 +299,10 @@ DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2
 
   // Boundary loops; input points are numbered source first, then target.
   std::vector<Points2> loops;
-  std::vector<Index> target_row;  // input number of each target point
+  bool crossing = false;
   if (closed) {
-    if (curve_intersections(source, target, true).points.rows() == 0 &&
-        !inside(source.row(0).transpose(), target) && !inside(target.row(0).transpose(), source)) {
+    crossing = curve_intersections(source, target, true).points.rows() > 0;
+    if (!crossing && !inside(source.row(0).transpose(), target) && !inside(target.row(0).transpose(), source)) {
       detail::invalid("c2", "diffusion mapping needs one curve inside the other, or crossing curves");
     }
     loops = {source, target};
@@ -324,14 +325,14 @@ DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2
   auto clock = Clock::now();
   double max_edge = options.mesh_size;
   if (max_edge == 0.0) {
-    // Mean gap: twice the region's area over its boundary length; a first, coarse mesh tells the
-    // area when curves cross.
-    const detail::RegionMesh coarse = detail::mesh_region(loops, 0.0);
+    // Mean gap: twice the region's area over its boundary length. The region of closed curves is
+    // their symmetric difference (an annulus when nested); of open ones, the loop that joins them.
     double area = 0.0;
-    for (Index t = 0; t < coarse.triangles.rows(); ++t) {
-      const Vec2 p0 = coarse.vertices.row(coarse.triangles(t, 0)).transpose();
-      area += 0.5 * cross(coarse.vertices.row(coarse.triangles(t, 1)).transpose() - p0,
-                          coarse.vertices.row(coarse.triangles(t, 2)).transpose() - p0);
+    if (closed) {
+      const double a1 = std::abs(signed_area(source)), a2 = std::abs(signed_area(target));
+      area = crossing ? a1 + a2 - 2.0 * overlap_area(source, target) : std::abs(a1 - a2);
+    } else {
+      area = std::abs(signed_area(loops[0]));
     }
     const double boundary = perimeter(source, closed) + perimeter(target, closed);
     max_edge = options.mesh_fraction * 2.0 * area / boundary;
