@@ -143,3 +143,10 @@ def test_index_is_reusable_and_threads_agree(rng, wobbly):
     first = index.closest_points(queries)
     again = index.closest_points(queries[::-1])
     assert np.array_equal(first.points, again.points[::-1])
+
+
+def test_lines_through_vertices_do_not_slip_between_segments():
+    inner, outer = circle(400, 1.0), circle(400, 2.0)
+    hits = mm.line_intersections(inner, inner, outer)  # radial lines through the vertices of outer
+    assert np.abs(hits.distances - 1.0).max() < 1e-12
+    assert np.abs(hits.points - outer).max() < 1e-12

@@ -69,7 +69,9 @@ struct Line {
 double box_line_bound(const CentredBox& b, const Line& l) {
   const double cx = b.cx - l.ox, cy = b.cy - l.oy;
   const double across = std::abs(l.ux * cy - l.uy * cx);  // distance of the centre from the line
-  if (across > l.ay * b.hx + l.ax * b.hy) return kInf;
+  // Slack for rounding: a line through a corner of the box must not miss it.
+  const double slack = 1e-12 * (std::abs(cx) + std::abs(cy) + b.hx + b.hy);
+  if (across > l.ay * b.hx + l.ax * b.hy + slack) return kInf;
   const double along = l.ux * cx + l.uy * cy, reach = l.ax * b.hx + l.ay * b.hy;
   return std::max(std::abs(along) - reach, 0.0);
 }
@@ -229,9 +231,12 @@ struct CurveIndex::Impl {
     const double ux = l.ux, uy = l.uy;
     const double denom = ux * s.ey - uy * s.ex;
     if (denom != 0.0) {
-      const double along = wx * uy - wy * ux;  // sp * denom
-      if (denom > 0.0 ? (along < 0.0 || along > denom) : (along > 0.0 || along < denom)) return;
-      const double sp = along / denom;
+      // sp * denom; a little slack so that a line through a vertex cannot slip between the two
+      // segments that meet there through rounding.
+      const double along = wx * uy - wy * ux;
+      const double slack = 1e-12 * std::abs(denom);
+      if (denom > 0.0 ? (along < -slack || along > denom + slack) : (along > slack || along < denom - slack)) return;
+      const double sp = std::min(std::max(along / denom, 0.0), 1.0);
       const double t = (wx * s.ey - wy * s.ex) / denom;
       if (line_hit_before(t, s.id, best)) {
         best.x = s.ax + sp * s.ex, best.y = s.ay + sp * s.ey;

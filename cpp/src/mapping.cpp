@@ -15,6 +15,7 @@
 #include <unsupported/Eigen/FFT>
 
 #include <algorithm>
+#include <cmath>
 #include <complex>
 #include <limits>
 #include <vector>
@@ -100,9 +101,17 @@ Method basic_method(MapMethod method) {
   }
 }
 
-// The paper's reverse diffusion on one job: streamlines from the target's points (but shared
-// crossings) back to the source, flipped.
-Vectors reverse_diffusion(const Job& job, const ArcCurve& whole_source) {
+// Start points per gap: the mean distance from the starts to the target over their mean spacing
+// along the source.
+double point_density(const Job& job, const Points2& starts) {
+  const double gap = CurveIndex(job.target, job.target_closed).closest_points(starts).distances.mean();
+  const double spacing = ArcCurve(job.source, job.source_closed, "c1").length() / starts.rows();
+  return spacing > 0.0 ? gap / spacing : 0.0;
+}
+
+// A basic algorithm run backwards on one job (the paper's reverse mapping): from the target's
+// points (but shared crossings) to the source, flipped.
+Vectors reverse(MapMethod method, const Job& job, const ArcCurve& whole_source) {
   Job back;
   back.source = job.target;
   back.source_closed = job.target_closed;
@@ -116,8 +125,9 @@ Vectors reverse_diffusion(const Job& job, const ArcCurve& whole_source) {
   }
   Vectors v;
   v.ends = start_points(back);
-  v.starts = basic_ends(MapMethod::diffusion, back, v.ends);
-  v.methods.assign(v.starts.rows(), Method::diffusion);
+  if (method == MapMethod::normal) back.normals = normals(back.source, back.source_closed)(back.start_rows, Eigen::all);
+  v.starts = basic_ends(method, back, v.ends);
+  v.methods.assign(v.starts.rows(), basic_method(method));
   v.keys.assign(v.starts.rows(), std::numeric_limits<double>::infinity());
   std::vector<Index> found;
   for (Index i = 0; i < v.starts.rows(); ++i) {
@@ -127,7 +137,7 @@ Vectors reverse_diffusion(const Job& job, const ArcCurve& whole_source) {
     Points2 located(found.size(), 2);
     for (std::size_t j = 0; j < found.size(); ++j) located.row(j) = v.starts.row(found[j]);
     const Vector arcs = CurveIndex(whole_source.points(), whole_source.closed()).closest_points(located).arc_lengths;
-    for (std::size_t j = 0; j < found.size(); ++j) v.keys[found[j]] = arcs[j];
+    for (std::size_t j = 0; j < found.size(); ++j) v.keys[found[j]] = whole_source.wrap(arcs[j]);
   }
   for (Index i = 0; i < v.starts.rows(); ++i) {
     if (!v.starts.row(i).allFinite()) v.ends.row(i).setConstant(kNaN);
@@ -136,17 +146,26 @@ Vectors reverse_diffusion(const Job& job, const ArcCurve& whole_source) {
 }
 
 // One job with one algorithm; "auto" is the paper's Algorithm 1 on the job: normal mapping, and
-// reverse diffusion instead when normal mapping gives crossings or misses.
+// reverse diffusion instead when normal mapping gives crossings or misses. With a density
+// threshold, the first attempt is reverse minimal distance where the start points are denser
+// than the threshold (the paper's "limiting case of an infinite number of points").
 Vectors run(MapMethod method, const Job& job, const std::vector<double>& start_keys,
-            const ArcCurve& whole_source) {
+            const ArcCurve& whole_source, double density_threshold) {
+  const bool automatic = method == MapMethod::automatic;
   Vectors v;
   v.starts = start_points(job);
-  v.ends = basic_ends(method == MapMethod::automatic ? MapMethod::normal : method, job, v.starts);
   v.keys = start_keys;
-  v.methods.assign(v.starts.rows(), basic_method(method == MapMethod::automatic ? MapMethod::normal : method));
-  if (method == MapMethod::automatic && v.starts.rows() > 0 &&
-      (!v.ends.allFinite() || count_crossings(v.starts, v.ends) > 0)) {
-    return reverse_diffusion(job, whole_source);
+  if (automatic && density_threshold > 0.0 && v.starts.rows() > 0 &&
+      point_density(job, v.starts) > density_threshold) {
+    v = reverse(MapMethod::minimal_distance, job, whole_source);
+  } else {
+    const MapMethod first = automatic ? MapMethod::normal : method;
+    v.ends = basic_ends(first, job, v.starts);
+    v.methods.assign(v.starts.rows(), basic_method(first));
+  }
+  if (automatic && v.starts.rows() > 0 &&
+      (!v.ends.allFinite() || !v.starts.allFinite() || count_crossings(v.starts, v.ends) > 0)) {
+    return reverse(MapMethod::diffusion, job, whole_source);
   }
   return v;
 }
@@ -228,7 +247,8 @@ Vectors gather(std::vector<Vectors>& parts) {
 }
 
 Vectors map_directed(const Points2& source_points, const Points2& target_points, MapMethod method,
-                     bool closed, bool split, const std::optional<std::pair<Vec2, Vec2>>& anchors) {
+                     bool closed, bool split, const std::optional<std::pair<Vec2, Vec2>>& anchors,
+                     double density_threshold) {
   const ArcCurve source(source_points, closed, "c1");
   const ArcCurve target(target_points, closed, "c2");
   const Index n = source.size();
@@ -280,7 +300,7 @@ Vectors map_directed(const Points2& source_points, const Points2& target_points,
       job.fractions.resize(n);
       for (Index i = 0; i < n; ++i) job.fractions[i] = source.forward(from, source.arc(i)) / source.length();
     }
-    std::vector<Vectors> parts{run(method, job, keys, source)};
+    std::vector<Vectors> parts{run(method, job, keys, source, density_threshold)};
     return gather(parts);
   }
 
@@ -363,7 +383,7 @@ Vectors map_directed(const Points2& source_points, const Points2& target_points,
     }
     std::vector<double> keys(m.size());
     for (std::size_t j = 0; j < m.size(); ++j) keys[j] = source.arc(m[j]);
-    parts.push_back(run(method, job, keys, source));
+    parts.push_back(run(method, job, keys, source, density_threshold));
   }
   return gather(parts);
 }
@@ -402,8 +422,12 @@ DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2,
   }
 
   DisplacementField2 field;
-  Vectors v = options.reverse ? map_directed(b, a, options.method, closed, options.split, anchors)
-                              : map_directed(a, b, options.method, closed, options.split, anchors);
+  if (!(options.density_threshold >= 0.0) || !std::isfinite(options.density_threshold)) {
+    detail::invalid("density_threshold", "must be a finite number >= 0 (0: off)");
+  }
+  Vectors v = options.reverse
+                  ? map_directed(b, a, options.method, closed, options.split, anchors, options.density_threshold)
+                  : map_directed(a, b, options.method, closed, options.split, anchors, options.density_threshold);
   field.starts = std::move(options.reverse ? v.ends : v.starts);
   field.ends = std::move(options.reverse ? v.starts : v.ends);
   // A reverse vector that found no start on C1 is missing as a whole.

@@ -27,7 +27,7 @@ void bind_mapping(py::module_& m) {
   m.def(
       "map_curves",
       [](const Points2Ref& c1, const Points2Ref& c2, const std::string& method, bool closed, Index n,
-         bool reverse, bool transform, bool split, std::optional<Vec2> anchor) {
+         bool reverse, bool transform, bool split, std::optional<Vec2> anchor, double density_threshold) {
         CurveMappingOptions options;
         options.method = map_method(method);
         options.closed = closed;
@@ -36,6 +36,7 @@ void bind_mapping(py::module_& m) {
         options.transform = transform;
         options.split = split;
         options.anchor = anchor;
+        options.density_threshold = density_threshold;
         DisplacementField2 field;
         {
           py::gil_scoped_release release;
@@ -46,7 +47,8 @@ void bind_mapping(py::module_& m) {
         return py::make_tuple(std::move(field.starts), std::move(field.ends), std::move(codes));
       },
       py::arg("c1"), py::arg("c2"), py::arg("method"), py::arg("closed"), py::arg("n"),
-      py::arg("reverse"), py::arg("transform"), py::arg("split"), py::arg("anchor"));
+      py::arg("reverse"), py::arg("transform"), py::arg("split"), py::arg("anchor"),
+      py::arg("density_threshold"));
 
   m.def(
       "solve_diffusion",

@@ -10,13 +10,17 @@ namespace morphomap {
 enum class MapMethod { minimal_distance, normal, diffusion, uniform, automatic };
 
 struct CurveMappingOptions {
-  MapMethod method = MapMethod::normal;
+  MapMethod method = MapMethod::automatic;  // the paper's Algorithm 1
   bool closed = true;       // both curves closed, or both open
   Index n = 0;              // 0: the given points of the source curve are the start points;
                             // > 0: both curves are first resampled to n equally spaced points
   bool reverse = false;     // map C2 -> C1 and flip the vectors
   bool transform = false;   // Appendix A: align a scaled C1 with C2 first, then carry back
   bool split = true;        // map each pair of segments between intersection points on its own
+  double density_threshold = 0.0;  // "auto": where the start points of a pair of segments are
+                                   // denser than this many per gap (mean distance to C2 over
+                                   // mean spacing), try reverse minimal distance before normal
+                                   // mapping (the paper's density rule); 0: off
   std::optional<Vec2> anchor;  // uniform mapping of closed curves that do not cross: a point
                                // of C1 (its nearest curve point) that maps onto its nearest
                                // point of C2
