@@ -29,10 +29,6 @@ def test_demo_runs_every_algorithm_and_writes_everything(tmp_path):
     out = run.stdout
     assert "split=True" in out
     table = [line.split() for line in out.splitlines()]
-    available = [m for m in demo.ALGORITHMS if demo.availability(m) is None]
-    assert {"minimal_distance", "normal", "uniform"} <= set(available)
-    for method in set(demo.ALGORITHMS) - set(available):
-        assert f"{method}: not available in this version" in out
     for pair in EXAMPLES:
         folder = tmp_path / "out" / pair
         assert (folder / "all.png").stat().st_size > 10_000
@@ -41,10 +37,7 @@ def test_demo_runs_every_algorithm_and_writes_everything(tmp_path):
             for variant in demo.VARIANTS:
                 row = [cells for cells in table if cells[:3] == [pair, method, variant]]
                 assert len(row) == 1, (pair, method, variant)
-                if method not in available:
-                    assert "not available" in " ".join(row[0])
-                    assert not (folder / f"{method}_{variant}.csv").exists()
-                    continue
+                assert (folder / f"{method}_{variant}.csv").exists()
                 qm1, qm2, qm, crossings, misses = row[0][3:]
                 field = mm.read_field(folder / f"{method}_{variant}.csv")
                 assert (folder / f"{method}_{variant}.png").stat().st_size > 10_000
@@ -52,11 +45,15 @@ def test_demo_runs_every_algorithm_and_writes_everything(tmp_path):
                 quality = mm.quality(field, c1, c2)
                 assert int(crossings) == quality.crossings
                 assert float(qm) == pytest.approx(quality.qm, rel=1e-3, nan_ok=True)
+        auto = [cells for cells in table if cells[:3] == [pair, "auto", "plain"]]
+        assert len(auto) == 1 and auto[0][6] == "0"  # the default workflow leaves no crossings
+        assert f"auto on {pair}: vectors made by" in out
+        assert (folder / "auto.png").exists() and len(mm.read_field(folder / "auto.csv")) > 0
     # The kidney pair is there to show crossings of plain normal mapping.
     normal = [cells for cells in table if cells[:3] == ["kidney", "normal", "plain"]][0]
     assert int(normal[6]) > 0
     assert str((tmp_path / "out").resolve()) in out
-    assert (tmp_path / "out" / "quality.csv").read_text().count("\n") == 1 + len(EXAMPLES) * 12
+    assert (tmp_path / "out" / "quality.csv").read_text().count("\n") == 1 + len(EXAMPLES) * 13
 
 
 def test_demo_default_folder_and_failures(monkeypatch):
@@ -99,18 +96,15 @@ def test_map_options_reach_map_curves(tmp_path):
     assert np.allclose(got, np.hstack([expected.starts, expected.ends]), rtol=0, atol=1e-15)
 
 
-def test_map_with_default_method_runs_or_says_auto_is_not_available(tmp_path):
-    c1, c2 = mm.load_example("circle_ellipse")
+def test_map_with_the_default_method(tmp_path):
+    c1, c2 = mm.load_example("kidney")
     mm.write_curve(tmp_path / "c1.csv", c1)
     mm.write_curve(tmp_path / "c2.csv", c2)
     run = morphomap("map", tmp_path / "c1.csv", tmp_path / "c2.csv", "-o", tmp_path / "f.csv")
-    if demo.availability("auto") is None:
-        assert run.returncode == 0, run.stderr
-        assert len(mm.read_field(tmp_path / "f.csv")) >= 100
-    else:
-        assert run.returncode == 2
-        assert "morphomap map: error: --method auto is not available" in run.stderr
-        assert "Traceback" not in run.stderr
+    assert run.returncode == 0, run.stderr
+    field = mm.read_field(tmp_path / "f.csv")
+    assert set(field.method) == {"normal", "diffusion"}
+    assert mm.count_crossings(field.starts, field.ends) == 0
 
 
 @pytest.mark.parametrize(

@@ -50,11 +50,8 @@ def _map(args, parser) -> int:
         field = map_curves(c1, c2, args.method, closed=args.closed, n=args.n, reverse=args.reverse,
                            transform=args.transform, split=args.split)
     except (ValueError, TypeError, morphomap.InvalidInput, morphomap.GeometryError) as error:
-        if args.method == "auto" and "auto" in str(error):
-            parser.error(f"--method auto is not available in this version ({error}); "
-                         "choose --method minimal_distance, normal or uniform")
         parser.error(f"cannot map {args.c1} onto {args.c2} with --method {args.method}: {error}")
-    q = quality(field, c1, c2, closed=args.closed) if field.dim == 2 else None
+    q = quality(field, c1, c2, closed=args.closed)
     try:
         write_field(sys.stdout if args.output == "-" else args.output, field)
         if args.plot:

@@ -33,21 +33,6 @@ _TITLES = {"minimal_distance": "minimal distance", "normal": "normal", "diffusio
 _VARIANT_TITLES = {"plain": "", "reverse": "reverse ", "transform": "transformed "}
 
 
-def availability(method: str):
-    """``None`` when ``map_curves(method=...)`` works in this build, else the reason it does not.
-
-    Tried once on two concentric circles; an algorithm that is not provided yet raises
-    ``ValueError`` there.
-    """
-    t = 2 * np.pi * np.arange(16) / 16
-    circle = np.column_stack([np.cos(t), np.sin(t)])
-    try:
-        map_curves(circle, 2 * circle, method)
-    except ValueError as error:
-        return str(error)
-    return None
-
-
 @dataclass
 class Row:
     """One line of the demo's table."""
@@ -62,7 +47,7 @@ class Row:
     misses: int = -1
     vectors: int = 0
     seconds: float = 0.0
-    note: str = ""  # why there are no numbers: not available, or the error raised
+    note: str = ""  # why there are no numbers: the error raised
 
     @property
     def ok(self) -> bool:
@@ -118,15 +103,11 @@ def run(out="morphomap-demo", *, pairs=EXAMPLES, stream=None, plots=True) -> lis
     stream = sys.stdout if stream is None else stream
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    unavailable = {method: availability(method) for method in ALGORITHMS}
-    available = [m for m in ALGORITHMS if unavailable[m] is None]
-    print(f"morphomap demo: {len(pairs)} example pairs x {len(available)} algorithms x {len(VARIANTS)} variants "
-          "(plain, reverse, transformed); every mapping with split=True (the curves are split where "
-          "they cross and each pair of segments is mapped on its own).", file=stream)
-    for method in ALGORITHMS:
-        if unavailable[method] is not None:
-            print(f"{method}: not available in this version ({unavailable[method]})", file=stream)
-    rows, written = [], []
+    print(f"morphomap demo: {len(pairs)} example pairs x {len(ALGORITHMS)} algorithms x {len(VARIANTS)} variants "
+          "(plain, reverse, transformed), then the automatic workflow (the paper's Algorithm 1, the "
+          "default); every mapping with split=True (the curves are split where they cross and each "
+          "pair of segments is mapped on its own).", file=stream)
+    rows, written, auto_used = [], [], {}
     started = time.perf_counter()
     for pair in pairs:
         c1, c2 = load_example(pair)
@@ -141,13 +122,6 @@ def run(out="morphomap-demo", *, pairs=EXAMPLES, stream=None, plots=True) -> lis
                 row = Row(pair, method, variant)
                 rows.append(row)
                 title = f"{_VARIANT_TITLES[variant]}{_TITLES[method]}".capitalize()
-                if unavailable[method] is not None:
-                    row.note = "not available in this version"
-                    if plots:
-                        axes[i, j].set_axis_off()
-                        axes[i, j].text(0.5, 0.5, f"{title}:\nnot available in this version",
-                                        ha="center", va="center", transform=axes[i, j].transAxes)
-                    continue
                 tick = time.perf_counter()
                 try:
                     field = map_curves(c1, c2, method, split=True, **_VARIANT_ARGUMENTS[variant])
@@ -173,12 +147,30 @@ def run(out="morphomap-demo", *, pairs=EXAMPLES, stream=None, plots=True) -> lis
                     single.savefig(stem.with_suffix(".png"), dpi=100)
                     written.append(stem.with_suffix(".png"))
                     plot_field(field, c1, c2, ax=axes[i, j], title=label)
+        # The default: normal mapping, reverse diffusion where it crosses or misses.
+        field = map_curves(c1, c2)
+        q = quality(field, c1, c2, closed=True)
+        names, counts = np.unique(field.method, return_counts=True)
+        used = ", ".join(f"{n} {c}" for n, c in zip(names, counts))
+        rows.append(Row(pair, "auto", "plain", q.qm1, q.qm2, q.qm, q.crossings, int((~field.valid).sum()),
+                        len(field)))
+        auto_used[pair] = used
+        write_field(folder / "auto.csv", field)
+        written.append(folder / "auto.csv")
+        if plots:
+            single, single_axes = _figure(1, 1, 6.0)
+            plot_field(field, c1, c2, ax=single_axes[0, 0],
+                       title=f"{pair}: auto ({used})\nQM1 {_number(q.qm1)}  QM2 {_number(q.qm2)}  QM {_number(q.qm)}")
+            single.savefig(folder / "auto.png", dpi=100)
+            written.append(folder / "auto.png")
         if plots:
             fig.suptitle(f"{pair}: C1 green, C2 blue, vectors red, crossing vectors orange, misses grey x")
             fig.savefig(folder / "all.png", dpi=80)
             written.append(folder / "all.png")
     table = format_table(rows)
     print(table, file=stream)
+    for pair, used in auto_used.items():
+        print(f"auto on {pair}: vectors made by {used}", file=stream)
     with open(out / "quality.csv", "w", encoding="utf-8") as handle:
         handle.write("pair,method,variant,qm1,qm2,qm,crossings,misses,vectors,note\n")
         for r in rows:
