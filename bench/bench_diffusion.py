@@ -47,7 +47,7 @@ TOO_SLOW = 60.0  # seconds: the scaling table stops after a size that takes long
 
 # The peer's tuned settings (mesh edge / mean gap, step / edge) from `bench_diffusion.py` on the
 # reference machine; the pytest benches use them, the script tunes again unless --no-tune.
-PEER_SETTINGS = {10**3: (0.0227, 1.0), 10**4: (0.0227, 1.0)}
+PEER_SETTINGS = {10**3: (0.0189, 1.0), 10**4: (0.0142, 1.0)}
 
 
 # --- cases -------------------------------------------------------------------------------------

@@ -5,6 +5,7 @@
 #include <morphomap/laplace.hpp>
 #include <morphomap/transform.hpp>
 
+#include "dirichlet.hpp"
 #include "region_mesh.hpp"
 #include "validation.hpp"
 
@@ -22,7 +23,9 @@ namespace morphomap {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-enum Kind : char { free_vertex = 0, source_vertex = 1, target_vertex = 2 };
+using detail::free_vertex;
+using detail::source_vertex;
+using detail::target_vertex;
 
 double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
 
@@ -40,50 +43,20 @@ bool inside(const Vec2& p, const Points2& polygon) {
   return in;
 }
 
-// Solves the Dirichlet problem: c fixed where kind != free, harmonic elsewhere.
+// The P1 solution on the triangles: local stiffness grad phi_i . grad phi_j * area.
 Vector solve_potential(const detail::RegionMesh& mesh, const std::vector<char>& kind) {
-  const Index n = mesh.vertices.rows();
-  std::vector<Index> unknown(n, -1);
-  Index free_count = 0;
-  Vector c(n);
-  for (Index v = 0; v < n; ++v) {
-    if (kind[v] == free_vertex) unknown[v] = free_count++;
-    c[v] = kind[v] == source_vertex ? 1.0 : 0.0;
-  }
-  if (free_count == 0) return c;
-  std::vector<Eigen::Triplet<double>> entries;
-  entries.reserve(9 * mesh.triangles.rows());
-  Vector rhs = Vector::Zero(free_count);
-  for (Index t = 0; t < mesh.triangles.rows(); ++t) {
+  return detail::solve_dirichlet(mesh.vertices.rows(), mesh.triangles, kind, [&](Index t) {
     Vec2 p[3];
     for (int i = 0; i < 3; ++i) p[i] = mesh.vertices.row(mesh.triangles(t, i)).transpose();
     const double area2 = cross(p[1] - p[0], p[2] - p[0]);
+    Eigen::Matrix3d k;
     for (int i = 0; i < 3; ++i) {
-      const Vec2 ei = p[(i + 2) % 3] - p[(i + 1) % 3];
       for (int j = 0; j < 3; ++j) {
-        const Vec2 ej = p[(j + 2) % 3] - p[(j + 1) % 3];
-        const double k = ei.dot(ej) / (2.0 * area2);  // grad phi_i . grad phi_j * area
-        const Index vi = mesh.triangles(t, i), vj = mesh.triangles(t, j);
-        if (unknown[vi] < 0) continue;
-        if (unknown[vj] >= 0) {
-          entries.emplace_back(unknown[vi], unknown[vj], k);
-        } else {
-          rhs[unknown[vi]] -= k * c[vj];
-        }
+        k(i, j) = (p[(i + 2) % 3] - p[(i + 1) % 3]).dot(p[(j + 2) % 3] - p[(j + 1) % 3]) / (2.0 * area2);
       }
     }
-  }
-  Eigen::SparseMatrix<double> stiffness(free_count, free_count);
-  stiffness.setFromTriplets(entries.begin(), entries.end());
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(stiffness);
-  if (solver.info() != Eigen::Success) {
-    throw GeometryError("the Laplace system is singular: a part of the region touches neither curve");
-  }
-  const Vector x = solver.solve(rhs);
-  for (Index v = 0; v < n; ++v) {
-    if (unknown[v] >= 0) c[v] = x[unknown[v]];
-  }
-  return c;
+    return k;
+  }, false);
 }
 
 // Follows -grad c from a vertex of the source until it meets the target. The P1 gradient is

@@ -4,6 +4,7 @@
 #include <morphomap/laplace3d.hpp>
 #include <morphomap/surface_queries.hpp>
 
+#include "dirichlet.hpp"
 #include "shell_mesh.hpp"
 #include "validation.hpp"
 
@@ -27,7 +28,9 @@ namespace {
 using Vec3 = Eigen::Vector3d;
 using Vec4 = Eigen::Vector4d;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-enum Kind : char { free_vertex = 0, source_vertex = 1, target_vertex = 2 };
+using detail::free_vertex;
+using detail::source_vertex;
+using detail::target_vertex;
 
 struct SurfaceFacts {
   double volume = 0.0;  // signed: positive when the faces are oriented outwards
@@ -63,61 +66,13 @@ double gradients(const Points3& vertices, const Tetrahedra& tets, Index t, Eigen
   return det / 6.0;
 }
 
+// The P1 solution on the tetrahedra: local stiffness volume * grad phi_i . grad phi_j.
 Vector solve_potential(const detail::ShellMesh& mesh, const std::vector<char>& kind) {
-  const Index n = mesh.vertices.rows();
-  std::vector<Index> unknown(n, -1);
-  Index free_count = 0;
-  Vector c(n);
-  for (Index v = 0; v < n; ++v) {
-    if (kind[v] == free_vertex) unknown[v] = free_count++;
-    c[v] = kind[v] == source_vertex ? 1.0 : 0.0;
-  }
-  if (free_count == 0) return c;
-  std::vector<Eigen::Triplet<double>> entries;
-  entries.reserve(16 * mesh.tetrahedra.rows());
-  Vector rhs = Vector::Zero(free_count);
-  Eigen::Matrix<double, 4, 3> g;
-  for (Index t = 0; t < mesh.tetrahedra.rows(); ++t) {
+  return detail::solve_dirichlet(mesh.vertices.rows(), mesh.tetrahedra, kind, [&](Index t) {
+    Eigen::Matrix<double, 4, 3> g;
     const double volume = std::abs(gradients(mesh.vertices, mesh.tetrahedra, t, g));
-    const Eigen::Matrix4d k = volume * g * g.transpose();
-    for (int i = 0; i < 4; ++i) {
-      const Index vi = mesh.tetrahedra(t, i);
-      if (unknown[vi] < 0) continue;
-      for (int j = 0; j < 4; ++j) {
-        const Index vj = mesh.tetrahedra(t, j);
-        if (unknown[vj] >= 0) {
-          entries.emplace_back(unknown[vi], unknown[vj], k(i, j));
-        } else {
-          rhs[unknown[vi]] -= k(i, j) * c[vj];
-        }
-      }
-    }
-  }
-  Eigen::SparseMatrix<double> stiffness(free_count, free_count);
-  stiffness.setFromTriplets(entries.begin(), entries.end());
-  // Conjugate gradients with an incomplete Cholesky preconditioner: far less memory and time than
-  // a direct factorisation at these sizes; the direct solver remains as a fallback.
-  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
-                           Eigen::IncompleteCholesky<double>>
-      cg;
-  cg.setTolerance(1e-10);
-  cg.setMaxIterations(std::max<Index>(1000, free_count));
-  cg.compute(stiffness);
-  Vector x;
-  if (cg.info() == Eigen::Success) {
-    x = cg.solve(rhs);
-  }
-  if (cg.info() != Eigen::Success || !x.allFinite()) {
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> direct(stiffness);
-    if (direct.info() != Eigen::Success) {
-      throw GeometryError("the Laplace system is singular: a part of the region touches neither surface");
-    }
-    x = direct.solve(rhs);
-  }
-  for (Index v = 0; v < n; ++v) {
-    if (unknown[v] >= 0) c[v] = x[unknown[v]];
-  }
-  return c;
+    return Eigen::Matrix4d(volume * g * g.transpose());
+  }, true);
 }
 
 // Follows -grad c from the source boundary of the mesh to its target boundary. As in 2D, the P1

@@ -3,6 +3,7 @@
 #include <morphomap/errors.hpp>
 
 #include "check.hpp"
+#include "shapes.hpp"
 
 #include <cmath>
 #include <limits>
@@ -16,16 +17,10 @@ using morphomap::Vec2;
 using morphomap::Vector;
 namespace mm = morphomap;
 
+using morphomap_test::pi;
+using morphomap_test::pts;
+
 namespace {
-
-const double pi = std::acos(-1.0);
-
-Points2 pts(std::initializer_list<std::pair<double, double>> list) {
-  Points2 p(static_cast<Index>(list.size()), 2);
-  Index i = 0;
-  for (const auto& [x, y] : list) p.row(i++) << x, y;
-  return p;
-}
 
 Points2 reversed(const Points2& p) { return p.colwise().reverse(); }
 

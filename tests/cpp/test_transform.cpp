@@ -4,6 +4,7 @@
 #include <morphomap/transform.hpp>
 
 #include "check.hpp"
+#include "shapes.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -23,20 +24,11 @@ using morphomap::Points2;
 using morphomap::Similarity2;
 using morphomap::Vec2;
 
+using morphomap_test::pi;
+using morphomap_test::pts;
+using morphomap_test::rect;
+
 namespace {
-
-const double pi = std::acos(-1.0);
-
-Points2 pts(std::initializer_list<std::pair<double, double>> list) {
-  Points2 p(static_cast<Index>(list.size()), 2);
-  Index i = 0;
-  for (const auto& [x, y] : list) p.row(i++) << x, y;
-  return p;
-}
-
-Points2 rect(double x0, double y0, double x1, double y1) {
-  return pts({{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}});
-}
 
 Points2 reversed(const Points2& p) { return p.colwise().reverse(); }
 

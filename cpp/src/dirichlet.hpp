@@ -1,0 +1,78 @@
+#pragma once
+// P1 finite elements for the Dirichlet problem of diffusion mapping, shared by the 2D (triangle)
+// and 3D (tetrahedron) solvers: c = 1 on the source, 0 on the target, harmonic elsewhere.
+#include <morphomap/errors.hpp>
+#include <morphomap/types.hpp>
+
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+
+#include <algorithm>
+#include <vector>
+
+namespace morphomap::detail {
+
+enum Kind : char { free_vertex = 0, source_vertex = 1, target_vertex = 2 };
+
+// elements: (E, K) vertex indices; local(e) returns element e's K x K stiffness matrix. With
+// iterative, conjugate gradients with an incomplete Cholesky preconditioner come first (less
+// memory and time for 3D meshes), the sparse LDL^T factorisation otherwise or as the fallback.
+template <class Elements, class Local>
+Vector solve_dirichlet(Index vertex_count, const Elements& elements, const std::vector<char>& kind,
+                       Local local, bool iterative) {
+  std::vector<Index> unknown(vertex_count, -1);
+  Index free_count = 0;
+  Vector c(vertex_count);
+  for (Index v = 0; v < vertex_count; ++v) {
+    if (kind[v] == free_vertex) unknown[v] = free_count++;
+    c[v] = kind[v] == source_vertex ? 1.0 : 0.0;
+  }
+  if (free_count == 0) return c;
+  const int corners = static_cast<int>(elements.cols());
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(corners * corners * elements.rows());
+  Vector rhs = Vector::Zero(free_count);
+  for (Index e = 0; e < elements.rows(); ++e) {
+    const auto k = local(e);
+    for (int i = 0; i < corners; ++i) {
+      const Index vi = elements(e, i);
+      if (unknown[vi] < 0) continue;
+      for (int j = 0; j < corners; ++j) {
+        const Index vj = elements(e, j);
+        if (unknown[vj] >= 0) {
+          entries.emplace_back(unknown[vi], unknown[vj], k(i, j));
+        } else {
+          rhs[unknown[vi]] -= k(i, j) * c[vj];
+        }
+      }
+    }
+  }
+  Eigen::SparseMatrix<double> stiffness(free_count, free_count);
+  stiffness.setFromTriplets(entries.begin(), entries.end());
+  Vector x;
+  bool solved = false;
+  if (iterative) {
+    Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
+                             Eigen::IncompleteCholesky<double>>
+        cg;
+    cg.setTolerance(1e-10);
+    cg.setMaxIterations(std::max<Index>(1000, free_count));
+    cg.compute(stiffness);
+    if (cg.info() == Eigen::Success) x = cg.solve(rhs);
+    solved = cg.info() == Eigen::Success && x.allFinite();
+  }
+  if (!solved) {
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> direct(stiffness);
+    if (direct.info() != Eigen::Success) {
+      throw GeometryError("the Laplace system is singular: a part of the region touches neither boundary");
+    }
+    x = direct.solve(rhs);
+  }
+  for (Index v = 0; v < vertex_count; ++v) {
+    if (unknown[v] >= 0) c[v] = x[unknown[v]];
+  }
+  return c;
+}
+
+}  // namespace morphomap::detail
