@@ -30,6 +30,12 @@ CALLS = {
     "curve_intersections_c2": lambda x: mm.curve_intersections(SQUARE + 0.5, x, closed=False),
     "crossing_pairs": lambda x: mm.crossing_pairs(x, np.asarray(x) * 0.5),
     "count_crossings": lambda x: mm.count_crossings(x, x),
+    "overlap_area": lambda x: mm.overlap_area(x, SQUARE),
+    "align_curves": lambda x: mm.align_curves(x, SQUARE * 2),
+    "map_curves_normal": lambda x: mm.map_curves(x, SQUARE * 3 - 1, "normal"),
+    "map_curves_uniform_open": lambda x: mm.map_curves(SQUARE, x, "uniform", closed=False),
+    "map_curves_auto": lambda x: mm.map_curves(x, SQUARE * 3 - 1),
+    "quality": lambda x: mm.quality(mm.map_curves(SQUARE, SQUARE * 3 - 1, "normal"), x, SQUARE * 3 - 1),
 }
 
 elements = st.one_of(
@@ -53,7 +59,25 @@ def test_random_arrays_never_crash(name, value):
     except (ValueError, TypeError) as error:
         assert str(error).split(":")[0] in {
             "points", "n", "queries", "curve", "origins", "directions", "c1", "c2", "starts", "ends",
+            "a", "b", "field",
         }, str(error)
+
+
+# Diffusion meshes the region between the curves: a second or so a call, so fewer examples.
+DIFFUSION_CALLS = {
+    "map_curves_diffusion": lambda x: mm.map_curves(SQUARE * 3 - 1, x, "diffusion", reverse=True),
+    "solve_diffusion": lambda x: mm.solve_diffusion(x, SQUARE * 3 - 1, mesh_fraction=0.1),
+}
+
+
+@pytest.mark.parametrize("name", sorted(DIFFUSION_CALLS))
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(value=arrays)
+def test_random_arrays_never_crash_diffusion(name, value):
+    try:
+        DIFFUSION_CALLS[name](value)
+    except (ValueError, TypeError, mm.GeometryError) as error:
+        assert isinstance(error, mm.GeometryError) or str(error).split(":")[0] in {"c1", "c2"}, str(error)
 
 
 @pytest.mark.parametrize(

@@ -16,6 +16,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <tuple>
 #include <vector>
 
 namespace morphomap {
@@ -130,7 +131,13 @@ class Tracer {
     Index vertex = start, t = -1;
     Vec2 x = point(start);
     record(x);
+    Index steps_here = 0, last_triangle = -1;  // a streamline that stalls in one triangle is lost
     for (Index step = 0; step < step_limit_; ++step) {
+      if (t >= 0 && t == last_triangle) {
+        if (++steps_here > kStallSteps) return lost;
+      } else {
+        steps_here = 0, last_triangle = t;
+      }
       if (vertex >= 0) {
         if (kind_[vertex] == target_vertex && vertex != start) return point(vertex);
         t = enter(vertex);
@@ -247,6 +254,9 @@ class Tracer {
     return true;
   }
 
+  // RK4 steps are a quarter of the smallest height, so a streamline crosses a triangle in a few
+  // of them; hundreds mean it has stalled (where the flow vanishes or turns back at a wall).
+  static constexpr Index kStallSteps = 1000;
   const detail::RegionMesh& mesh_;
   const Vector& c_;
   const std::vector<char>& kind_;
@@ -262,6 +272,27 @@ DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2
                                   bool closed, const DiffusionOptions& options) {
   const Index ns = detail::require_curve(source_points, closed, "c1");
   const Index nt = detail::require_curve(target_points, closed, "c2");
+  // Meshing squares lengths: keep them far from overflow and underflow.
+  for (const auto& [points, rows, name] : {std::tuple(&source_points, ns, "c1"), std::tuple(&target_points, nt, "c2")}) {
+    const auto p = points->topRows(rows);
+    const double far = p.cwiseAbs().maxCoeff();
+    const double extent = (p.colwise().maxCoeff() - p.colwise().minCoeff()).norm();
+    if (!(far <= 1e100) || !(extent >= 1e-100)) {
+      detail::invalid(name, "diffusion mapping needs coordinates within 1e100 of the origin and a curve "
+                            "wider than 1e-100 (rescale the curves)");
+    }
+  }
+  if (closed) {
+    detail::require_area(source_points.topRows(ns), "c1");
+    detail::require_area(target_points.topRows(nt), "c2");
+  }
+  // The region between the curves is only defined for simple ones.
+  if (is_self_intersecting(source_points.topRows(ns), closed)) {
+    detail::invalid("c1", "the curve intersects itself; diffusion mapping needs a simple curve");
+  }
+  if (is_self_intersecting(target_points.topRows(nt), closed)) {
+    detail::invalid("c2", "the curve intersects itself; diffusion mapping needs a simple curve");
+  }
   if (!(options.mesh_size >= 0.0) || !std::isfinite(options.mesh_size)) {
     detail::invalid("mesh_size", "must be a finite length >= 0");
   }
@@ -311,6 +342,7 @@ DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2
     max_edge = options.mesh_fraction * 2.0 * area / boundary;
   }
   const detail::RegionMesh mesh = detail::mesh_region(loops, max_edge);
+  if (mesh.triangles.rows() == 0) throw GeometryError("the region between the curves is empty");
   solution.mesh_seconds = seconds_since(clock);
   clock = Clock::now();
 
@@ -346,9 +378,16 @@ DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2
   if (options.keep_streamlines) solution.streamlines.resize(ns);
   tbb::parallel_for(Index(0), ns, [&](Index i) {
     std::vector<Vec2> path;
+    // A point of C1 that bounds no part of the region (where the curves run together) or lies
+    // on C2 already stays where it is if it is on C2; streamlines start at the others.
     const Index start = mesh.of_input[i];
-    const Vec2 end = kind[start] == target_vertex ? mesh.vertices.row(start).transpose().eval()
-                                                  : tracer.trace(start, options.keep_streamlines ? &path : nullptr);
+    const Vec2 here = source.row(i).transpose();
+    Vec2 end(kNaN, kNaN);
+    if (start < 0 || kind[start] == target_vertex) {
+      if (on_target.closest_points(source.row(i)).distances[0] <= 1e-10 * scale) end = here;
+    } else {
+      end = tracer.trace(start, options.keep_streamlines ? &path : nullptr);
+    }
     solution.ends.row(i) = end.transpose();
     if (options.keep_streamlines) {
       if (path.empty()) path.push_back(end);

@@ -400,8 +400,8 @@ DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2,
                               std::string(closed ? "3" : "2") + ", got " + std::to_string(options.n));
   }
   if (closed) {
-    if (signed_area(c1.topRows(n1)) == 0.0) detail::invalid("c1", "the closed curve encloses zero area");
-    if (signed_area(c2.topRows(n2)) == 0.0) detail::invalid("c2", "the closed curve encloses zero area");
+    detail::require_area(c1.topRows(n1), "c1");
+    detail::require_area(c2.topRows(n2), "c2");
   }
   Points2 a = options.n > 0 ? resample(c1, options.n, closed) : Points2(c1.topRows(n1));
   const Points2 b = options.n > 0 ? resample(c2, options.n, closed) : Points2(c2.topRows(n2));

@@ -34,6 +34,8 @@ using Cdt = CGAL::Constrained_Delaunay_triangulation_2<Kernel, Tds, CGAL::Exact_
 using Criteria = CGAL::Delaunay_mesh_size_criteria_2<Cdt>;
 using Point = Cdt::Point;
 
+constexpr std::size_t kMaxVertices = 8'000'000;
+
 // Faces inside an odd number of loops: flood fill from the infinite faces, one connected
 // component at a time, a constrained edge raising the nesting level by one.
 void mark_odd_nesting(Cdt& cdt) {
@@ -99,8 +101,19 @@ RegionMesh mesh_region(const std::vector<Points2>& loops, double max_edge) {
       }
       first += n;
     }
+    // Collinear loops (curves that run together all along) bound no area at all.
+    if (cdt.dimension() < 2) throw GeometryError("the region between the curves is empty");
     mark_odd_nesting(cdt);
-    CGAL::refine_Delaunay_mesh_2(cdt, Criteria(0.125, max_edge > 0 ? max_edge : 0.0), true);
+    // Refine step by step so that a degenerate input cannot run away with time and memory.
+    CGAL::Delaunay_mesher_2<Cdt, Criteria> mesher(cdt, Criteria(0.125, max_edge > 0 ? max_edge : 0.0));
+    mesher.init(true);
+    while (mesher.try_one_step_refine_mesh()) {
+      if (cdt.number_of_vertices() > kMaxVertices) {
+        throw GeometryError("meshing the region between the curves needs more than " +
+                            std::to_string(kMaxVertices) + " vertices: the region is degenerate, or "
+                            "the mesh size far too small for it");
+      }
+    }
   } catch (const CGAL::Failure_exception& e) {
     throw GeometryError(std::string("meshing the region between the curves failed: ") + e.what());
   }

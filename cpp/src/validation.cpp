@@ -1,5 +1,7 @@
 #include "validation.hpp"
 
+#include <morphomap/curve_geometry.hpp>
+
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
 
@@ -56,6 +58,13 @@ Points2 without_repeats(const Points2Ref& points, bool closed, const char* name)
   }
   out.conservativeResize(m, 2);
   return out;
+}
+
+void require_area(const Points2Ref& points, const char* name) {
+  const double length = perimeter(points, true);
+  if (!(std::abs(signed_area(points)) > 1e-14 * length * length)) {
+    invalid(name, "the closed curve encloses zero area");
+  }
 }
 
 int thread_count() { return tbb::this_task_arena::max_concurrency(); }

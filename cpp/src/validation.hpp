@@ -23,6 +23,10 @@ Index require_curve(const Points2Ref& points, bool closed, const char* name);
 // still have enough points.
 Points2 without_repeats(const Points2Ref& points, bool closed, const char* name);
 
+// A closed curve (as checked by require_curve) whose area is not (nearly) zero against the square
+// of its length: no orientation to trust, no region to mesh otherwise.
+void require_area(const Points2Ref& points, const char* name);
+
 // Number of worker threads the kernels use.
 int thread_count();
 
