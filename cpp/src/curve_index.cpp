@@ -23,7 +23,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr int kLeafSize = 4;
 constexpr Index kGrain = 256;
-constexpr int kStackSize = 96;  // depth of a median-split tree over < 2^31 segments is < 40
+constexpr int kStackSize = 128;  // < 32 levels (a child holds at most half its parent) of < 4 pushes
 
 struct Box {
   double lo[2] = {kInf, kInf};
@@ -34,17 +34,18 @@ struct Box {
   }
 };
 
-// A box as centre and half extents: the form the query tests need.
-struct CentredBox {
-  double cx, cy, hx, hy;
-};
-
-// Inner nodes keep their left child right after themselves, so only the right one is stored.
+// A node of the 4-wide hierarchy: its children's boxes side by side (so that the four box tests
+// run together) and their references. A reference >= 0 is an inner node; a leaf is ~(first * 8 +
+// count) over the segment arrays; kUnused marks an unused slot (its box is empty).
+constexpr int kWidth = 4;
 struct Node {
-  CentredBox box;
-  std::int32_t first;  // leaf: first slot in the segment arrays; inner: index of the right child
-  std::int32_t count;  // leaf: number of segments; inner: 0
+  double cx[kWidth], cy[kWidth], hx[kWidth], hy[kWidth];
+  std::int64_t child[kWidth];
 };
+constexpr std::int64_t kUnused = std::numeric_limits<std::int64_t>::max();
+static_assert(kLeafSize < 8, "a leaf reference keeps its count in 3 bits");
+
+std::int64_t leaf_ref(std::int32_t first, std::int32_t count) { return ~(std::int64_t{first} * 8 + count); }
 
 // One segment a + s * e, s in [0, 1], stored in leaf order for locality.
 struct Segment {
@@ -54,27 +55,10 @@ struct Segment {
   std::int64_t id;   // index in the curve: from point id to point id + 1
 };
 
-double box_distance2(const CentredBox& b, double x, double y) {
-  const double dx = std::max(std::abs(x - b.cx) - b.hx, 0.0);
-  const double dy = std::max(std::abs(y - b.cy) - b.hy, 0.0);
-  return dx * dx + dy * dy;
-}
-
 // A line o + t u with |u| = 1, and |u|'s components for the box tests.
 struct Line {
   double ox, oy, ux, uy, ax, ay;
 };
-
-// Smallest |t| of a point of the box on the line, or +inf when the line misses the box.
-double box_line_bound(const CentredBox& b, const Line& l) {
-  const double cx = b.cx - l.ox, cy = b.cy - l.oy;
-  const double across = std::abs(l.ux * cy - l.uy * cx);  // distance of the centre from the line
-  // Slack for rounding: a line through a corner of the box must not miss it.
-  const double slack = 1e-12 * (std::abs(cx) + std::abs(cy) + b.hx + b.hy);
-  if (across > l.ay * b.hx + l.ax * b.hy + slack) return kInf;
-  const double along = l.ux * cx + l.uy * cy, reach = l.ax * b.hx + l.ay * b.hy;
-  return std::max(std::abs(along) - reach, 0.0);
-}
 
 struct Hit {
   double x = kNaN, y = kNaN, distance = kNaN, s = 0.0;
@@ -116,27 +100,16 @@ struct CurveIndex::Impl {
       s.id = i;
       arc += s.length;
     }
-    nodes.reserve(2 * (count / kLeafSize + 1));
+    nodes.reserve(count / kLeafSize + 1);
     build(0, static_cast<std::int32_t>(count));
   }
 
   // Median split on the longer axis of the centroid box; segments are reordered in place.
-  std::int32_t build(std::int32_t begin, std::int32_t end) {
-    const auto index = static_cast<std::int32_t>(nodes.size());
-    nodes.push_back({});
-    Box box, centres;
+  std::int32_t split(std::int32_t begin, std::int32_t end) {
+    Box centres;
     for (std::int32_t i = begin; i < end; ++i) {
       const Segment& s = segments[i];
-      box.grow(s.ax, s.ay);
-      box.grow(s.ax + s.ex, s.ay + s.ey);
       centres.grow(s.ax + 0.5 * s.ex, s.ay + 0.5 * s.ey);
-    }
-    nodes[index].box = {0.5 * (box.lo[0] + box.hi[0]), 0.5 * (box.lo[1] + box.hi[1]),
-                         0.5 * (box.hi[0] - box.lo[0]), 0.5 * (box.hi[1] - box.lo[1])};
-    if (end - begin <= kLeafSize) {
-      nodes[index].first = begin;
-      nodes[index].count = end - begin;
-      return index;
     }
     const int axis = (centres.hi[0] - centres.lo[0]) >= (centres.hi[1] - centres.lo[1]) ? 0 : 1;
     const std::int32_t middle = begin + (end - begin) / 2;
@@ -145,26 +118,88 @@ struct CurveIndex::Impl {
                        return axis == 0 ? a.ax + 0.5 * a.ex < b.ax + 0.5 * b.ex
                                         : a.ay + 0.5 * a.ey < b.ay + 0.5 * b.ey;
                      });
-    build(begin, middle);
-    const std::int32_t right = build(middle, end);
-    nodes[index].first = right;
-    nodes[index].count = 0;
+    return middle;
+  }
+
+  // A node over [begin, end): the range is split (largest part first) into up to four parts;
+  // parts of at most kLeafSize segments become leaves, the others nodes of their own.
+  std::int64_t build(std::int32_t begin, std::int32_t end) {
+    const auto index = static_cast<std::int64_t>(nodes.size());
+    nodes.push_back({});
+    std::int32_t lo[kWidth] = {begin}, hi[kWidth] = {end};
+    int parts = 1;
+    while (parts < kWidth) {
+      int largest = -1;
+      for (int k = 0; k < parts; ++k) {
+        if (hi[k] - lo[k] > kLeafSize && (largest < 0 || hi[k] - lo[k] > hi[largest] - lo[largest])) largest = k;
+      }
+      if (largest < 0) break;
+      const std::int32_t middle = split(lo[largest], hi[largest]);
+      lo[parts] = middle, hi[parts] = hi[largest], hi[largest] = middle;
+      ++parts;
+    }
+    for (int k = 0; k < kWidth; ++k) {
+      Node& nd = nodes[index];
+      if (k >= parts) {
+        nd.cx[k] = nd.cy[k] = 0.0, nd.hx[k] = nd.hy[k] = 0.0, nd.child[k] = kUnused;
+        continue;
+      }
+      Box box;
+      for (std::int32_t i = lo[k]; i < hi[k]; ++i) {
+        const Segment& s = segments[i];
+        box.grow(s.ax, s.ay);
+        box.grow(s.ax + s.ex, s.ay + s.ey);
+      }
+      nd.cx[k] = 0.5 * (box.lo[0] + box.hi[0]), nd.cy[k] = 0.5 * (box.lo[1] + box.hi[1]);
+      nd.hx[k] = 0.5 * (box.hi[0] - box.lo[0]), nd.hy[k] = 0.5 * (box.hi[1] - box.lo[1]);
+      if (hi[k] - lo[k] <= kLeafSize) {
+        nd.child[k] = leaf_ref(lo[k], hi[k] - lo[k]);
+      } else {
+        const std::int64_t child = build(lo[k], hi[k]);  // may move `nodes`
+        nodes[index].child[k] = child;
+      }
+    }
     return index;
+  }
+
+  // Sorts the four (bound, reference) pairs of a node by bound, nearest first, without branches
+  // (a sorting network: which children a line or point reaches is unpredictable).
+  static void order(double* bound, std::int64_t* ref) {
+    auto exchange = [bound, ref](int i, int j) {
+      const double bi = bound[i], bj = bound[j];
+      const std::int64_t ri = ref[i], rj = ref[j];
+      const bool swap = bj < bi;
+      bound[i] = swap ? bj : bi, bound[j] = swap ? bi : bj;
+      ref[i] = swap ? rj : ri, ref[j] = swap ? ri : rj;
+    };
+    exchange(0, 1), exchange(2, 3), exchange(0, 2), exchange(1, 3), exchange(1, 2);
+  }
+
+  // Pushes the kept children but the nearest onto the stack, farthest first, and makes the
+  // nearest the current one; false when no child is kept.
+  static bool descend(double* bound, std::int64_t* ref, int kept, std::int64_t* stack, double* stack_bound,
+                      int& top, std::int64_t& current, double& current_bound) {
+    if (kept == 0) return false;
+    order(bound, ref);
+    for (int k = kept - 1; k > 0; --k) stack[top] = ref[k], stack_bound[top++] = bound[k];
+    current = ref[0], current_bound = bound[0];
+    return true;
   }
 
   Hit closest(double qx, double qy) const {
     Hit best;
     double best_d2 = kInf;
-    std::int32_t stack[kStackSize];
+    std::int64_t stack[kStackSize];
     double bound[kStackSize];
     int top = 0;
-    std::int32_t node = 0;
-    double node_bound = 0.0;
+    std::int64_t ref = 0;
+    double ref_bound = 0.0;
     for (;;) {
-      if (node_bound <= best_d2) {
-        const Node& nd = nodes[node];
-        if (nd.count > 0) {
-          for (std::int32_t k = nd.first; k < nd.first + nd.count; ++k) {
+      if (ref_bound <= best_d2) {
+        if (ref < 0) {
+          const std::int64_t code = ~ref;
+          const auto first = static_cast<std::int32_t>(code >> 3), count = static_cast<std::int32_t>(code & 7);
+          for (std::int32_t k = first; k < first + count; ++k) {
             const Segment& s = segments[k];
             const double len2 = s.ex * s.ex + s.ey * s.ey;
             double t = len2 > 0 ? ((qx - s.ax) * s.ex + (qy - s.ay) * s.ey) / len2 : 0.0;
@@ -177,18 +212,27 @@ struct CurveIndex::Impl {
             }
           }
         } else {
-          std::int32_t near = node + 1, far = nd.first;
-          double near_d2 = box_distance2(nodes[near].box, qx, qy);
-          double far_d2 = box_distance2(nodes[far].box, qx, qy);
-          if (far_d2 < near_d2) std::swap(near, far), std::swap(near_d2, far_d2);
-          if (far_d2 <= best_d2) stack[top] = far, bound[top++] = far_d2;
-          node = near, node_bound = near_d2;
-          continue;
+          const Node& nd = nodes[ref];
+          double d2[kWidth];  // squared distances to the four boxes
+          for (int k = 0; k < kWidth; ++k) {
+            const double dx = std::max(std::abs(qx - nd.cx[k]) - nd.hx[k], 0.0);
+            const double dy = std::max(std::abs(qy - nd.cy[k]) - nd.hy[k], 0.0);
+            d2[k] = dx * dx + dy * dy;
+          }
+          std::int64_t child[kWidth];
+          int kept = 0;
+          for (int k = 0; k < kWidth; ++k) {
+            const bool keep = d2[k] <= best_d2 && nd.child[k] != kUnused;
+            kept += keep;
+            d2[k] = keep ? d2[k] : kInf;
+            child[k] = nd.child[k];
+          }
+          if (descend(d2, child, kept, stack, bound, top, ref, ref_bound)) continue;
         }
       }
       if (top == 0) break;
       --top;
-      node = stack[top], node_bound = bound[top];
+      ref = stack[top], ref_bound = bound[top];
     }
     best.distance = std::sqrt(best_d2);
     return best;
@@ -196,30 +240,49 @@ struct CurveIndex::Impl {
 
   Hit line(const Line& l) const {
     Hit best;
-    std::int32_t stack[kStackSize];
+    std::int64_t stack[kStackSize];
     double bound[kStackSize];
     int top = 0;
-    std::int32_t node = 0;
-    double node_bound = box_line_bound(nodes[0].box, l);
+    std::int64_t ref = 0;
+    double ref_bound = 0.0;
     auto beaten = [&best](double b) { return b == kInf || (best.segment && b > std::abs(best.distance)); };
     for (;;) {
-      if (!beaten(node_bound)) {
-        const Node& nd = nodes[node];
-        if (nd.count > 0) {
-          for (std::int32_t k = nd.first; k < nd.first + nd.count; ++k) visit(segments[k], l, best);
+      if (!beaten(ref_bound)) {
+        if (ref < 0) {
+          const std::int64_t code = ~ref;
+          const auto first = static_cast<std::int32_t>(code >> 3), count = static_cast<std::int32_t>(code & 7);
+          for (std::int32_t k = first; k < first + count; ++k) visit(segments[k], l, best);
         } else {
-          std::int32_t near = node + 1, far = nd.first;
-          double near_b = box_line_bound(nodes[near].box, l);
-          double far_b = box_line_bound(nodes[far].box, l);
-          if (far_b < near_b) std::swap(near, far), std::swap(near_b, far_b);
-          if (!beaten(far_b)) stack[top] = far, bound[top++] = far_b;
-          node = near, node_bound = near_b;
-          continue;
+          const Node& nd = nodes[ref];
+          double b[kWidth];
+          for (int k = 0; k < kWidth; ++k) {
+            // Smallest |t| of a point of the box on the line, or +inf when the line misses it:
+            // the centre's distance from the line against the box's half width across it, with
+            // slack for rounding so that a line through a corner of the box cannot miss it.
+            const double cx = nd.cx[k] - l.ox, cy = nd.cy[k] - l.oy;
+            const double across = std::abs(l.ux * cy - l.uy * cx);
+            const double slack = 1e-12 * (std::abs(cx) + std::abs(cy) + nd.hx[k] + nd.hy[k]);
+            const double along = l.ux * cx + l.uy * cy, reach = l.ax * nd.hx[k] + l.ay * nd.hy[k];
+            const double near = std::max(std::abs(along) - reach, 0.0);
+            b[k] = across > l.ay * nd.hx[k] + l.ax * nd.hy[k] + slack ? kInf : near;
+          }
+          // Not beaten (see `beaten`: a NaN bound is not beaten).
+          const double limit = best.segment ? std::abs(best.distance) : kInf;
+          std::int64_t child[kWidth];
+          int kept = 0;
+          for (int k = 0; k < kWidth; ++k) {
+            const bool keep = b[k] != kInf && !(b[k] > limit) && nd.child[k] != kUnused;
+            kept += keep;
+            // A NaN bound (overflowing boxes) is never beaten, like 0, which also sorts.
+            b[k] = keep ? (b[k] == b[k] ? b[k] : 0.0) : kInf;
+            child[k] = nd.child[k];
+          }
+          if (descend(b, child, kept, stack, bound, top, ref, ref_bound)) continue;
         }
       }
       if (top == 0) break;
       --top;
-      node = stack[top], node_bound = bound[top];
+      ref = stack[top], ref_bound = bound[top];
     }
     return best;
   }
