@@ -255,16 +255,84 @@ def test_quality_of_the_identity_and_a_scaling(sphere):
     assert exact.qm == 0.0
 
 
-def test_folds_count_turned_over_images(sphere):
+def octasphere(levels):
+    """An octahedron subdivided ``levels`` times onto the unit sphere; outward faces. Its equator
+    z = 0 runs along edges, so every face lies in one half, and it is symmetric in z exactly."""
+    vertices = [np.array(p, float) for p in
+                ([1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1])]
+    faces = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]]
+    for _ in range(levels):
+        middle = {}
+
+        def mid(a, b):
+            key = (min(a, b), max(a, b))
+            if key not in middle:
+                p = vertices[a] + vertices[b]
+                vertices.append(p / np.linalg.norm(p))
+                middle[key] = len(vertices) - 1
+            return middle[key]
+
+        out = []
+        for a, b, c in faces:
+            ab, bc, ca = mid(a, b), mid(b, c), mid(c, a)
+            out += [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]
+        faces = out
+    return np.array(vertices), np.array(faces, np.int64)
+
+
+def normals_in_space(starts, ends, f):
+    """n_j . N_j of the start triangles and their images: negative where an image is merely
+    tilted by more than 90 degrees in space (what folds used to count)."""
+    n = np.cross(starts[f[:, 1]] - starts[f[:, 0]], starts[f[:, 2]] - starts[f[:, 0]])
+    image = np.cross(ends[f[:, 1]] - ends[f[:, 0]], ends[f[:, 2]] - ends[f[:, 0]])
+    return np.einsum("ij,ij->i", n, image)
+
+
+def test_folds_count_every_triangle_of_a_mirror_image(sphere):
     v, f = sphere
     field = mm.map_surfaces((v, f), (v, f), "minimal_distance")
-    ends = field.ends * [1, 1, -1]  # a mirror: turns over the triangles facing up or down
+    ends = field.ends * [1, 1, -1]  # a mirror: the map reverses orientation everywhere
     mirrored = mm.DisplacementField(field.starts, ends, field.method, f)
-    n = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
-    image = np.cross(ends[f[:, 1]] - ends[f[:, 0]], ends[f[:, 2]] - ends[f[:, 0]])
-    expected = int((np.einsum("ij,ij->i", n, image) < 0).sum())
-    assert 0 < expected < len(f)
-    assert mm.quality(mirrored, (v, f), (v * [1, 1, -1], f[:, ::-1])).folds == expected
+    # The mirrored sphere with its faces reversed, so that they face out again.
+    assert mm.quality(mirrored, (v, f), (v * [1, 1, -1], f[:, ::-1])).folds == len(f)
+
+
+def test_no_folds_under_an_affine_map(sphere):
+    # The sphere onto a rotated, translated ellipsoid by the exact affine map: no image is turned
+    # over, although many are tilted by more than 90 degrees in space.
+    v, f = sphere
+    angle, axis = 2.5, np.array([1.0, 2.0, 3.0]) / np.sqrt(14.0)
+    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    rotation = np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * k @ k
+    a = rotation @ np.diag(AXES)
+    ends = v @ a.T + [5.0, -1.0, 2.0]
+    field = mm.DisplacementField(v, ends, "normal", f)
+    assert (normals_in_space(v, ends, f) < 0).sum() > len(f) // 10
+    assert mm.quality(field, (v, f), (ends, f)).folds == 0
+    # The same ellipsoid mirrored (faces reversed to face out): every image is turned over.
+    mirrored = ends * [-1, 1, 1]
+    field = mm.DisplacementField(v, mirrored, "normal", f)
+    assert mm.quality(field, (v, f), (mirrored, f[:, ::-1])).folds == len(f)
+
+
+def test_folds_of_a_hemisphere_folded_down():
+    # z -> -|z|: the upper half is mirrored onto the lower, the lower half stays. Exactly the upper
+    # faces are turned over, whether or not they tilt by more than 90 degrees in space.
+    v, f = octasphere(4)
+    ends = v * [1, 1, 1]
+    ends[:, 2] = -np.abs(v[:, 2])
+    upper = v[f, 2].max(axis=1) > 0
+    assert upper.sum() == len(f) // 2
+    tilted = normals_in_space(v, ends, f) < 0
+    assert 0 < tilted.sum() < upper.sum()
+    field = mm.DisplacementField(v, ends, "normal", f)
+    assert mm.quality(field, (v, f), (v, f)).folds == upper.sum()
+    # A miss is not a fold: NaN at the north pole takes its four faces out of the count.
+    pole = int(np.flatnonzero(v[:, 2] == 1)[0])
+    ends[pole] = np.nan
+    field = mm.DisplacementField(v, ends, "normal", f)
+    assert (f == pole).any(axis=1).sum() == 4
+    assert mm.quality(field, (v, f), (v, f)).folds == upper.sum() - 4
 
 
 def test_trimesh_input(sphere):

@@ -53,7 +53,7 @@ double tetrahedron(const V3& a, const V3& b, const V3& c, const V3& d) {
 }
 
 // Every valid row of `points` within `tolerance` of the surface.
-void require_on(const Points3Ref& points, const Points3Ref& v, const FacesRef& f, const char* what) {
+void require_on(const Points3Ref& points, const Points3Ref& v, const SurfaceIndex& index, const char* what) {
   std::vector<Index> rows;
   for (Index i = 0; i < points.rows(); ++i) {
     if (points.row(i).allFinite()) rows.push_back(i);
@@ -62,7 +62,7 @@ void require_on(const Points3Ref& points, const Points3Ref& v, const FacesRef& f
   Points3 found(rows.size(), 3);
   for (std::size_t k = 0; k < rows.size(); ++k) found.row(k) = points.row(rows[k]);
   const double tolerance = 1e-6 * (v.colwise().maxCoeff() - v.colwise().minCoeff()).norm();
-  const Vector d = SurfaceIndex(v, f).closest_points(found).distances;
+  const Vector d = index.closest_points(found).distances;
   for (std::size_t k = 0; k < rows.size(); ++k) {
     if (!(d[k] <= tolerance)) {
       detail::invalid("field", std::string(what) + " " + std::to_string(rows[k]) + " is " + std::to_string(d[k]) +
@@ -71,24 +71,89 @@ void require_on(const Points3Ref& points, const Points3Ref& v, const FacesRef& f
   }
 }
 
+// Unit normal of face `face` of (v, f); InvalidInput naming `name` when the index that found it
+// was not built from this surface.
+V3 unit_face_normal(const Points3Ref& v, const FacesRef& f, Index face, const char* name) {
+  if (face < 0 || face >= f.rows()) detail::invalid(name, "the surface index does not match its faces");
+  const V3 a = detail::corner(v, f, face, 0);
+  const V3 n = (detail::corner(v, f, face, 1) - a).cross(detail::corner(v, f, face, 2) - a);
+  const double length = n.norm();
+  return length > 0 ? V3(n / length) : V3::Zero();
+}
+
+// For each triangle of `faces` over the rows of `points` (only where `use`), the sum nu of the unit
+// normals of the surface's faces closest to its three corners and to its centroid. The corners lie
+// on the surface, so their faces give the normal right there, even when the triangle is large
+// against the surface's curvature (across a thin tube its centroid sinks towards the axis); but a
+// corner on a vertex or edge of the surface gets any of the faces meeting there, while the
+// centroid of a small triangle lies over the face it covers. Together they outvote either failure.
+Points3 normals_under(const Points3Ref& points, const FacesRef& faces, const std::vector<char>& use,
+                      const Points3Ref& v, const FacesRef& f, const SurfaceIndex& index, const char* name) {
+  std::vector<Index> rows;
+  for (Index i = 0; i < points.rows(); ++i) {
+    if (points.row(i).allFinite()) rows.push_back(i);
+  }
+  Points3 at_rows = Points3::Zero(points.rows(), 3);
+  Points3 nu = Points3::Zero(faces.rows(), 3);
+  if (rows.empty()) return nu;
+  {
+    Points3 queries(rows.size(), 3);
+    for (std::size_t k = 0; k < rows.size(); ++k) queries.row(k) = points.row(rows[k]);
+    const IndexVector hit = index.closest_points(queries).faces;
+    for (std::size_t k = 0; k < rows.size(); ++k) at_rows.row(rows[k]) = unit_face_normal(v, f, hit[k], name).transpose();
+  }
+  std::vector<Index> triangles;
+  for (Index j = 0; j < faces.rows(); ++j) {
+    if (use[j]) triangles.push_back(j);
+  }
+  Points3 centroids(triangles.size(), 3);
+  for (std::size_t k = 0; k < triangles.size(); ++k) {
+    const Index j = triangles[k];
+    centroids.row(k) = (points.row(faces(j, 0)) + points.row(faces(j, 1)) + points.row(faces(j, 2))) / 3.0;
+  }
+  if (triangles.empty()) return nu;
+  const IndexVector hit = index.closest_points(centroids).faces;
+  for (std::size_t k = 0; k < triangles.size(); ++k) {
+    const Index j = triangles[k];
+    nu.row(j) = unit_face_normal(v, f, hit[k], name).transpose() + at_rows.row(faces(j, 0)) +
+                at_rows.row(faces(j, 1)) + at_rows.row(faces(j, 2));
+  }
+  return nu;
+}
+
 }  // namespace
 
-Index count_folds(const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces) {
+Index count_folds(const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, const Points3Ref& v1,
+                  const FacesRef& f1, const SurfaceIndex& index1, const Points3Ref& v2, const FacesRef& f2,
+                  const SurfaceIndex& index2) {
   if (ends.rows() != starts.rows()) detail::invalid("ends", "must have as many rows as starts");
   require_field_faces(faces, starts.rows(), "faces");
+  std::vector<char> use(faces.rows());
+  for (Index j = 0; j < faces.rows(); ++j) use[j] = usable(starts, ends, faces, j);
+  const Points3 nu1 = normals_under(starts, faces, use, v1, f1, index1, "s1");
+  const Points3 nu2 = normals_under(ends, faces, use, v2, f2, index2, "s2");
   return tbb::parallel_reduce(
       tbb::blocked_range<Index>(0, faces.rows(), 1024), Index{0},
       [&](const tbb::blocked_range<Index>& range, Index count) {
         for (Index j = range.begin(); j < range.end(); ++j) {
-          if (!usable(starts, ends, faces, j)) continue;
+          if (!use[j]) continue;
           const V3 p0 = detail::corner(starts, faces, j, 0), q0 = detail::corner(ends, faces, j, 0);
           const V3 n = (detail::corner(starts, faces, j, 1) - p0).cross(detail::corner(starts, faces, j, 2) - p0);
           const V3 m = (detail::corner(ends, faces, j, 1) - q0).cross(detail::corner(ends, faces, j, 2) - q0);
-          if (n.dot(m) < 0) ++count;
+          // Signs only: the product of two dot products of unscaled vectors could underflow.
+          const double on1 = n.dot(nu1.row(j).transpose()), on2 = m.dot(nu2.row(j).transpose());
+          if ((on1 < 0 && on2 > 0) || (on1 > 0 && on2 < 0)) ++count;
         }
         return count;
       },
       [](Index a, Index b) { return a + b; });
+}
+
+Index count_folds(const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, const Points3Ref& v1,
+                  const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2) {
+  check_closed_surface(v1, f1, "s1");
+  check_closed_surface(v2, f2, "s2");
+  return count_folds(starts, ends, faces, v1, f1, SurfaceIndex(v1, f1), v2, f2, SurfaceIndex(v2, f2));
 }
 
 SurfaceQuality quality(const DisplacementField3& field, const Points3Ref& v1, const FacesRef& f1,
@@ -99,8 +164,9 @@ SurfaceQuality quality(const DisplacementField3& field, const Points3Ref& v1, co
     detail::invalid("field", "starts and ends must both have shape (M, 3)");
   }
   require_field_faces(field.faces, field.size(), "field");
-  require_on(field.starts, v1, f1, "start point");
-  require_on(field.ends, v2, f2, "end point");
+  const SurfaceIndex index1(v1, f1), index2(v2, f2);
+  require_on(field.starts, v1, index1, "start point");
+  require_on(field.ends, v2, index2, "end point");
 
   const double alpha = surface_area(v2, f2) / surface_area(v1, f1);
   const Index count = field.faces.rows();
@@ -135,7 +201,7 @@ SurfaceQuality quality(const DisplacementField3& field, const Points3Ref& v1, co
     q.qm2 = kNaN;
   }
   q.qm = q.qm1 * q.qm2;
-  q.folds = count_folds(field.starts, field.ends, field.faces);
+  q.folds = count_folds(field.starts, field.ends, field.faces, v1, f1, index1, v2, f2, index2);
   return q;
 }
 

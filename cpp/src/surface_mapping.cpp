@@ -25,19 +25,21 @@ struct Surface {
   FacesRef faces;
 };
 
-// Vectors from the vertices of `source` to `target` with one basic algorithm.
-DisplacementField3 basic(MapMethod method, const Surface& source, const Surface& target, double mesh_size) {
+// Vectors from the vertices of `source` to `target` (queried through `target_index`, built from
+// it) with one basic algorithm.
+DisplacementField3 basic(MapMethod method, const Surface& source, const Surface& target,
+                         const SurfaceIndex& target_index, double mesh_size) {
   DisplacementField3 field;
   field.starts = source.vertices;
   field.faces = source.faces;
   switch (method) {
     case MapMethod::minimal_distance:
-      field.ends = SurfaceIndex(target.vertices, target.faces).closest_points(field.starts).points;
+      field.ends = target_index.closest_points(field.starts).points;
       field.methods.assign(field.size(), Method::minimal_distance);
       break;
     case MapMethod::normal: {
       const Points3 normals = vertex_normals(source.vertices, source.faces);
-      field.ends = SurfaceIndex(target.vertices, target.faces).line_intersections(field.starts, normals).points;
+      field.ends = target_index.line_intersections(field.starts, normals).points;
       field.methods.assign(field.size(), Method::normal);
       break;
     }
@@ -56,7 +58,7 @@ DisplacementField3 basic(MapMethod method, const Surface& source, const Surface&
       }
       found.resize(rows.size(), 3);
       for (std::size_t k = 0; k < rows.size(); ++k) found.row(k) = field.ends.row(rows[k]);
-      const Points3 on_target = SurfaceIndex(target.vertices, target.faces).closest_points(found).points;
+      const Points3 on_target = target_index.closest_points(found).points;
       for (std::size_t k = 0; k < rows.size(); ++k) field.ends.row(rows[k]) = on_target.row(k);
       field.methods.assign(field.size(), Method::diffusion);
       break;
@@ -78,13 +80,18 @@ DisplacementField3 flipped(DisplacementField3 field) {
 }
 
 DisplacementField3 directed(MapMethod method, const Surface& source, const Surface& target, double mesh_size) {
-  if (method != MapMethod::automatic) return basic(method, source, target, mesh_size);
-  DisplacementField3 field = basic(MapMethod::normal, source, target, mesh_size);
+  const SurfaceIndex target_index(target.vertices, target.faces);
+  if (method != MapMethod::automatic) return basic(method, source, target, target_index, mesh_size);
+  DisplacementField3 field = basic(MapMethod::normal, source, target, target_index, mesh_size);
   bool missed = false;
   for (Index i = 0; i < field.size() && !missed; ++i) missed = !field.valid(i);
-  if (!missed && count_folds(field.starts, field.ends, field.faces) == 0) return field;
+  const SurfaceIndex source_index(source.vertices, source.faces);
+  if (!missed && count_folds(field.starts, field.ends, field.faces, source.vertices, source.faces, source_index,
+                             target.vertices, target.faces, target_index) == 0) {
+    return field;
+  }
   // Reverse diffusion: streamlines from the target's vertices back to the source, turned round.
-  return flipped(basic(MapMethod::diffusion, target, source, mesh_size));
+  return flipped(basic(MapMethod::diffusion, target, source, source_index, mesh_size));
 }
 
 }  // namespace

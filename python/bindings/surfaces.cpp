@@ -96,5 +96,12 @@ void bind_surfaces(py::module_& m) {
       },
       py::arg("starts"), py::arg("ends"), py::arg("faces"), py::arg("v1"), py::arg("f1"), py::arg("v2"),
       py::arg("f2"));
-  m.def("count_folds", &count_folds, py::arg("starts"), py::arg("ends"), py::arg("faces"), Release());
+  m.def(
+      "count_folds",
+      [](const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, const Points3Ref& v1,
+         const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2) {
+        return count_folds(starts, ends, faces, v1, f1, v2, f2);
+      },
+      py::arg("starts"), py::arg("ends"), py::arg("faces"), py::arg("v1"), py::arg("f1"), py::arg("v2"),
+      py::arg("f2"), Release());
 }

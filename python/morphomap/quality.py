@@ -99,9 +99,16 @@ def quality(field, c1, c2, *, closed=True):
     - :math:`\mathrm{QM}_2 = \frac{1}{K} \sum_j \left(\frac{V_j}{\langle V \rangle} - 1\right)^2`
       with :math:`\langle V \rangle = \frac{1}{K} \sum_j V_j`;
       :math:`\mathrm{QM} = \mathrm{QM}_1 \cdot \mathrm{QM}_2`.
-    - ``folds``: the number of triangles whose image is turned over,
-      :math:`n_j \cdot N_j < 0` with :math:`n_j = (p_1 - p_0) \times (p_2 - p_0)` and
-      :math:`N_j` the same of the images.
+    - ``folds``: the number of triangles whose image is turned over relative to the surfaces
+      (where the map from S1 to S2 reverses orientation):
+      :math:`(n_j \cdot \nu^1_j)(N_j \cdot \nu^2_j) < 0`, with
+      :math:`n_j = (p_1 - p_0) \times (p_2 - p_0)`, :math:`N_j` the same of the images (corners
+      in the order of the face row), :math:`\nu^1_j` the sum of the outward unit normals of the
+      faces of S1 closest to :math:`p_0, p_1, p_2` and to their centroid, and :math:`\nu^2_j` the
+      same on S2 for the images. A triangle lying on its surface as that surface is oriented has
+      :math:`n \cdot \nu > 0`, so tilt in space does not count (a bud that grows out sideways,
+      a rotation, a scaling), a locally mirrored image does; triangles with a zero-area start
+      or image are not folds.
 
     Both surfaces must be closed; valid start points must lie on S1 and valid end points on S2
     (within :math:`10^{-6}` of the surface's bounding-box diagonal).

@@ -155,7 +155,8 @@ int main() {
   CHECK(normal.size() == sphere.vertices.rows());
   CHECK(normal.faces == sphere.faces);
   for (Index i = 0; i < normal.size(); ++i) CHECK(normal.valid(i));
-  CHECK(count_folds(normal.starts, normal.ends, normal.faces) == 0);
+  CHECK(count_folds(normal.starts, normal.ends, normal.faces, sphere.vertices, sphere.faces, ellipsoid.vertices,
+                    ellipsoid.faces) == 0);
   const SurfaceQuality qn = quality(normal, sphere.vertices, sphere.faces, ellipsoid.vertices, ellipsoid.faces);
   CHECK(qn.folds == 0);
   CHECK(std::isfinite(qn.qm1) && std::isfinite(qn.qm2) && qn.qm1 < 0.5);
@@ -180,6 +181,53 @@ int main() {
   CHECK(back.faces == ellipsoid.faces);
   CHECK((back.ends - ellipsoid.vertices).cwiseAbs().maxCoeff() == 0.0);
   for (Index i = 0; i < back.size(); ++i) CHECK(std::abs(back.starts.row(i).norm() - 1.0) < 0.01);
+
+  // The ellipsoid's normals near its long-axis tips cross before they reach the sphere (radius of
+  // curvature 1.2^2 / 2 = 0.72 in the xz plane, 1 to go), so their images there are turned over.
+  CHECK(count_folds(back.starts, back.ends, back.faces, sphere.vertices, sphere.faces, ellipsoid.vertices,
+                    ellipsoid.faces) > 0);
+
+  // Folds against closed forms. An affine map with a positive determinant turns nothing over,
+  // however far it tilts the triangles in space.
+  {
+    const Eigen::Matrix3d a = Eigen::AngleAxisd(2.5, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix() *
+                              Eigen::Vector3d(2.0, 0.7, 1.3).asDiagonal();
+    const Points3 moved = (sphere.vertices * a.transpose()).rowwise() + Eigen::RowVector3d(5, -1, 2);
+    CHECK(count_folds(sphere.vertices, moved, sphere.faces, sphere.vertices, sphere.faces, moved, sphere.faces) == 0);
+    // A mirror turns every triangle over (the mirrored surface needs its faces reversed to face out).
+    Points3 mirrored = moved;
+    mirrored.col(0) *= -1.0;
+    Faces reversed = sphere.faces;
+    reversed.col(1).swap(reversed.col(2));
+    CHECK(count_folds(sphere.vertices, mirrored, sphere.faces, sphere.vertices, sphere.faces, mirrored, reversed) ==
+          sphere.faces.rows());
+  }
+  // Folding the upper half of the sphere down onto the lower (z -> -z where z > 0; the equator runs
+  // along edges of this mesh) turns exactly the upper faces over, although many of them are tilted
+  // by less than 90 degrees; a miss (NaN) takes the faces around it out of the count.
+  {
+    Points3 folded = sphere.vertices;
+    for (Index i = 0; i < folded.rows(); ++i) folded(i, 2) = -std::abs(folded(i, 2));
+    Index upper = 0;
+    for (Index j = 0; j < sphere.faces.rows(); ++j) {
+      double top = -1.0;
+      for (int k = 0; k < 3; ++k) top = std::max(top, sphere.vertices(sphere.faces(j, k), 2));
+      if (top > 0) ++upper;
+    }
+    CHECK(upper == sphere.faces.rows() / 2);
+    CHECK(count_folds(sphere.vertices, folded, sphere.faces, sphere.vertices, sphere.faces, sphere.vertices,
+                      sphere.faces) == upper);
+    folded.row(4).setConstant(std::numeric_limits<double>::quiet_NaN());  // the north pole, on 4 faces
+    CHECK(count_folds(sphere.vertices, folded, sphere.faces, sphere.vertices, sphere.faces, sphere.vertices,
+                      sphere.faces) == upper - 4);
+    Faces out = sphere.faces;
+    out(0, 0) = sphere.vertices.rows();
+    CHECK_THROWS(count_folds(sphere.vertices, folded, out, sphere.vertices, sphere.faces, sphere.vertices,
+                             sphere.faces), InvalidInput);
+    const Faces open = sphere.faces.topRows(sphere.faces.rows() - 1);
+    CHECK_THROWS(count_folds(sphere.vertices, folded, sphere.faces, sphere.vertices, sphere.faces, sphere.vertices,
+                             open), InvalidInput);
+  }
 
   options.method = MapMethod::uniform;
   CHECK_THROWS(map_surfaces(sphere.vertices, sphere.faces, ellipsoid.vertices, ellipsoid.faces, options), InvalidInput);

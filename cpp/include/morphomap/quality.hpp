@@ -1,6 +1,7 @@
 #pragma once
 // The paper's quality measures of a 2D displacement field (section "Quantitative Evaluation").
 #include <morphomap/field.hpp>
+#include <morphomap/surface_queries.hpp>
 #include <morphomap/types.hpp>
 
 namespace morphomap {
@@ -48,10 +49,29 @@ struct SurfaceQuality {
   Index folds = 0;   // triangles whose image is turned over
 };
 
-// Number of triangles j of `faces` (rows of starts/ends; a triangle with a NaN row is skipped)
-// whose image is turned over: n_j . N_j < 0, where n_j = (p1 - p0) x (p2 - p0) of the start
-// points and N_j the same of the end points.
-Index count_folds(const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces);
+// Number of triangles j of `faces` (rows of starts/ends) whose image is turned over relative to
+// the surfaces, i.e. where the map from S1 to S2 reverses orientation:
+//   n_j  = (p1 - p0) x (p2 - p0) of the start points, N_j the same of the end points (corners in
+//          the order of the face row);
+//   nu1_j = the sum of the unit normals of the faces of S1 closest to p0, p1, p2 and to the
+//          centroid (p0 + p1 + p2) / 3; nu2_j the same on S2 for P0, P1, P2;
+//   fold  when (n_j . nu1_j) * (N_j . nu2_j) < 0.
+// A triangle lying on its surface as that surface is oriented has n . nu > 0: a start triangle
+// that is a face of S1 counts when its image faces into S2, and, for the faces of S2 mapped back
+// (reverse fields), an image that is a face of S2 counts when its start triangle faces into S1.
+// Tilt in space does not count, so a smooth deformation (a bud that grows out sideways) gives none,
+// nor does a translation, rotation or scaling; an image that is locally mirrored does. A triangle
+// with a NaN row (a miss), or with a zero-area start or image, is not a fold.
+// Both surfaces must be closed with outward faces (check_closed_surface, named "s1" and "s2");
+// faces must index the rows of starts, else InvalidInput naming "faces".
+Index count_folds(const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, const Points3Ref& v1,
+                  const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2);
+
+// The same with the surfaces' indices already built (index1 from v1, f1 and index2 from v2, f2),
+// for callers that query the surfaces anyway; the surfaces are not checked again.
+Index count_folds(const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, const Points3Ref& v1,
+                  const FacesRef& f1, const SurfaceIndex& index1, const Points3Ref& v2, const FacesRef& f2,
+                  const SurfaceIndex& index2);
 
 // Quality of a 3D field p_i -> P_i (our definitions; the paper gives none for 3D).
 //
@@ -67,7 +87,7 @@ Index count_folds(const Points3Ref& starts, const Points3Ref& ends, const FacesR
 //   <V>   = (1/K) sum_j V_j,  QM2 = (1/K) sum_j (V_j / <V> - 1)^2.
 //   QM    = QM1 * QM2.
 // A measure is NaN when it has nothing to average over (no triangle, or <V> == 0).
-// folds = count_folds(field.starts, field.ends, field.faces).
+// folds = count_folds(field.starts, field.ends, field.faces, v1, f1, v2, f2).
 //
 // Both surfaces must pass check_closed_surface (named "s1", "s2"); every valid start point must
 // lie on S1 and every valid end point on S2 within 1e-6 of the surface's bounding-box diagonal,
