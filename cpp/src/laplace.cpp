@@ -1,4 +1,4 @@
-// P1 finite elements for the Laplace equation on the region mesh, and exact streamline tracing.
+// P1 finite elements for the Laplace equation on the region mesh, and streamline tracing.
 #include <morphomap/curve_geometry.hpp>
 #include <morphomap/curve_queries.hpp>
 #include <morphomap/errors.hpp>

@@ -20,9 +20,11 @@ struct RegionMesh {
 
 // The region is the set of points inside an odd number of the loops (an annulus for two nested
 // loops, each lobe of the symmetric difference for two crossing ones). Every input point is a
-// mesh vertex. Refinement: Ruppert's angle criterion (smallest angle about 20.7 degrees), which
-// grades the mesh from the point spacing on the loops and refines narrow gaps, and edges no
-// longer than max_edge (no bound when max_edge <= 0).
+// mesh vertex. With max_edge > 0, the loops' edges are split to at most max_edge and a triangular
+// lattice of spacing just under max_edge is seeded inside, a spacing away from the loops. Then
+// refinement: Ruppert's angle criterion (smallest angle about 20.7 degrees), which grades the mesh
+// from the point spacing on the loops and refines narrow gaps, and edges no longer than max_edge
+// (no bound when max_edge <= 0).
 RegionMesh mesh_region(const std::vector<Points2>& loops, double max_edge);
 
 }  // namespace morphomap::detail

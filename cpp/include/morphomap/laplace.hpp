@@ -29,9 +29,10 @@ struct DiffusionSolution {
 
 // The region between source and target: closed curves must be nested (an annulus) or cross (each
 // lobe of their symmetric difference on its own); open curves are joined start to start and end to
-// end by straight edges where c is free (no flux). Streamlines are traced exactly in the P1
-// solution, whose gradient is constant on each triangle: straight inside a triangle, along an
-// edge where the flows of its two triangles meet.
+// end by straight edges where c is free (no flux). The mesh: a triangular lattice of spacing
+// ~mesh_size inside the region, joined to the curves by CGAL's constrained Delaunay mesher. The P1
+// gradient is recovered at the vertices and interpolated linearly (a continuous flow whose
+// streamlines do not cross), and each streamline crosses the mesh triangle by triangle in RK4 steps.
 DiffusionSolution solve_diffusion(const Points2Ref& source, const Points2Ref& target,
                                   bool closed = true, const DiffusionOptions& options = {});
 
