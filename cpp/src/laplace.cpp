@@ -69,7 +69,8 @@ Vector solve_potential(const detail::RegionMesh& mesh, const std::vector<char>& 
 class Tracer {
  public:
   Tracer(const detail::RegionMesh& mesh, const Vector& c, const std::vector<char>& kind)
-      : mesh_(mesh), c_(c), kind_(kind), step_(mesh.triangles.rows()) {
+      : mesh_(mesh), c_(c), kind_(kind), step_(mesh.triangles.rows()), to_barycentric_(mesh.triangles.rows()),
+        flow_(mesh.triangles.rows()) {
     const Index n = mesh.vertices.rows(), triangles = mesh.triangles.rows();
     offsets_.assign(n + 1, 0);
     for (Index t = 0; t < triangles; ++t) {
@@ -100,6 +101,12 @@ class Tracer {
         weight[mesh.triangles(t, i)] += area2;
       }
       step_[t] = 0.25 * area2 / longest;  // a quarter of the smallest height
+      // Barycentric coordinates as an affine map of x: l_i = (cross(p_j - x, p_k - x)) / area2.
+      Affine& map = to_barycentric_[t];
+      for (int i = 0; i < 3; ++i) {
+        const Vec2 pj = p[(i + 1) % 3], pk = p[(i + 2) % 3];
+        map.row(i) << (pj.y() - pk.y()) / area2, (pk.x() - pj.x()) / area2, cross(pj, pk) / area2;
+      }
     }
     for (Index v = 0; v < n; ++v) velocity_[v] /= weight[v];
     // On the curves c is constant, so the flow is normal to them: keep only the normal part of
@@ -119,6 +126,11 @@ class Tracer {
       if (kind[v] == free_vertex || normal[v].squaredNorm() == 0.0) continue;
       const Vec2 unit = normal[v].normalized();
       velocity_[v] = velocity_[v].dot(unit) * unit;
+    }
+    for (Index t = 0; t < triangles; ++t) {
+      Eigen::Matrix<double, 2, 3> corners;
+      for (int i = 0; i < 3; ++i) corners.col(i) = velocity_[mesh.triangles(t, i)];
+      flow_[t] = corners * to_barycentric_[t];
     }
     step_limit_ = 40 * (triangles + n) + 1000;
   }
@@ -194,9 +206,7 @@ class Tracer {
   Vec2 point(Index v) const { return mesh_.vertices.row(v).transpose(); }
 
   Eigen::Vector3d barycentric(Index t, const Vec2& x) const {
-    const Vec2 p0 = point(mesh_.triangles(t, 0)), p1 = point(mesh_.triangles(t, 1)), p2 = point(mesh_.triangles(t, 2));
-    const double area2 = cross(p1 - p0, p2 - p0);
-    return Eigen::Vector3d(cross(p1 - x, p2 - x), cross(p2 - x, p0 - x), cross(p0 - x, p1 - x)) / area2;
+    return to_barycentric_[t].leftCols<2>() * x + to_barycentric_[t].col(2);
   }
 
   double c_at(Index t, const Vec2& x) const {
@@ -206,9 +216,7 @@ class Tracer {
 
   // Unit direction of the recovered flow at x, interpolated on triangle t.
   Vec2 direction(Index t, const Vec2& x) const {
-    const Eigen::Vector3d l = barycentric(t, x);
-    const Vec2 u = l[0] * velocity_[mesh_.triangles(t, 0)] + l[1] * velocity_[mesh_.triangles(t, 1)] +
-                   l[2] * velocity_[mesh_.triangles(t, 2)];
+    const Vec2 u = flow_[t].leftCols<2>() * x + flow_[t].col(2);
     const double norm = u.norm();
     return norm > 0.0 ? Vec2(u / norm) : Vec2::Zero();
   }
@@ -262,6 +270,13 @@ class Tracer {
   const std::vector<char>& kind_;
   std::vector<Vec2> velocity_;  // recovered -grad c at the vertices
   std::vector<double> step_;    // RK4 step length in each triangle
+  // Each triangle's barycentric coordinates as an affine map of the point: the tracer evaluates
+  // them several times per step, and this saves reading its three corners each time.
+  using Affine = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+  std::vector<Affine, Eigen::aligned_allocator<Affine>> to_barycentric_;
+  // The interpolated flow on each triangle, also affine in the point.
+  using AffineFlow = Eigen::Matrix<double, 2, 3>;
+  std::vector<AffineFlow, Eigen::aligned_allocator<AffineFlow>> flow_;
   std::vector<Index> offsets_, incident_;
   Index step_limit_ = 0;
 };
