@@ -453,3 +453,77 @@ def test_random_arrays_never_crash(vertices, faces, queries):
             call()
         except (ValueError, TypeError):
             pass
+
+
+def cube():
+    """The cube [-1, 1]^3, each square split along a diagonal; outward faces."""
+    v = np.array([[x, y, z] for x in (-1.0, 1.0) for y in (-1.0, 1.0) for z in (-1.0, 1.0)])
+    quads = [[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]]
+    f = [[a, b, c] for a, b, c, d in quads] + [[a, c, d] for a, b, c, d in quads]
+    return v, np.array(f, np.int64)
+
+
+def octahedron():
+    v = np.array([[1.0, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]])
+    f = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]]
+    return v, np.array(f, np.int64)
+
+
+@pytest.mark.parametrize("shape", [cube, octahedron])
+@pytest.mark.parametrize("placed", [False, True])
+def test_lines_through_vertices_and_edges_all_hit(rng, shape, placed):
+    v, f = shape()
+    # Vertices, edge midpoints and points a third of the way along every edge (diagonals too).
+    edges = {tuple(sorted((a, b))) for a, b, c in f for a, b in ((a, b), (b, c), (c, a))}
+    targets = np.vstack([v] + [v[a] + s * (v[b] - v[a]) for a, b in sorted(edges) for s in (0.5, 1 / 3)])
+    inside = np.vstack([np.zeros((1, 3)), rng.uniform(-0.3, 0.3, (5, 3))])
+    # From points inside through each target, and from outside straight at it.
+    origins = np.repeat(inside, len(targets), axis=0)
+    directions = np.tile(targets, (len(inside), 1)) - origins
+    origins = np.vstack([origins, origins + 3.0 * directions])
+    directions = np.vstack([directions, -directions])
+    if placed:  # rounded in the unit box and in float
+        v, origins = 3.7 * v + [10.0, -4.0, 2.0], 3.7 * origins + [10.0, -4.0, 2.0]
+    hits = mm.SurfaceIndex(v, f).line_intersections(origins, directions)
+    assert not np.isnan(hits.distances).any()
+    with np.errstate(invalid="ignore"):  # lines parallel to some faces
+        expected, tie = brute_lines(v, f, origins, directions)
+    size = np.ptp(v, axis=0).max()
+    assert np.abs(np.abs(hits.distances) - np.abs(expected)).max() <= 1e-9 * size
+    assert np.abs(hits.distances[~tie] - expected[~tie]).max() <= 1e-9 * size
+
+
+def test_many_lines_on_a_large_surface_in_any_order(rng):
+    # Enough faces and lines for the index to trace the lines in spatial order: the answers are
+    # those of the same lines asked in small batches, which keep their order.
+    rings, segments = 300, 256
+    theta = np.pi * np.arange(1, rings) / rings
+    phi = 2 * np.pi * np.arange(segments) / segments
+    t, p = np.meshgrid(theta, phi, indexing="ij")
+    ring = np.column_stack([np.sin(t).ravel() * np.cos(p).ravel(), np.sin(t).ravel() * np.sin(p).ravel(),
+                            np.cos(t).ravel()])
+    v = np.vstack([[0, 0, 1], ring, [0, 0, -1]]) * AXES
+    j = np.arange(segments)
+    r = np.arange(rings - 2)[:, None]
+    a, b = 1 + r * segments + j, 1 + r * segments + (j + 1) % segments
+    south, last = len(v) - 1, 1 + (rings - 2) * segments
+    f = np.vstack([np.column_stack([np.zeros(segments, int), 1 + j, 1 + (j + 1) % segments]),
+                   np.column_stack([np.full(segments, south), last + (j + 1) % segments, last + j]),
+                   np.column_stack([a.ravel(), (a + segments).ravel(), b.ravel()]),
+                   np.column_stack([b.ravel(), (a + segments).ravel(), (b + segments).ravel()])]).astype(np.int64)
+    assert len(f) >= 2**17
+    origins, directions = random_lines(rng, 50_000)
+    origins[:1000] = 0.0
+    directions[1000:2000] = v[rng.choice(len(v), 1000)]
+    index = mm.SurfaceIndex(v, f)
+    hits = index.line_intersections(origins, directions)
+    for k in range(0, len(origins), 10_000):
+        part = index.line_intersections(origins[k:k + 10_000], directions[k:k + 10_000])
+        np.testing.assert_array_equal(part.faces, hits.faces[k:k + 10_000])
+        np.testing.assert_array_equal(part.distances, hits.distances[k:k + 10_000])
+        np.testing.assert_array_equal(part.points, hits.points[k:k + 10_000])
+    pick = rng.choice(len(origins), 20, replace=False)
+    expected, tie = brute_lines(v, f, origins[pick], directions[pick])
+    assert np.array_equal(np.isnan(hits.distances[pick]), np.isnan(expected))
+    found = ~np.isnan(expected)
+    assert np.abs(np.abs(hits.distances[pick][found]) - np.abs(expected[found])).max() <= 1e-9 * 4.0
