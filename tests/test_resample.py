@@ -255,3 +255,19 @@ def test_large_n(method):
 def test_invalid_input(method, points, n, closed, argument):
     with pytest.raises(ValueError, match=f"^{argument}"):
         mm.resample(np.array(points, float), n, closed=closed, method=method)
+
+
+@pytest.mark.parametrize("method", ["linear", "spline", "pchip"])
+@pytest.mark.parametrize("points", [
+    [[5e-324, 0.0], [0.0, 0.0]],
+    [[-2.5e-292, 0.0], [0.0, 0.0]],
+    [[0.0, 0.0], [5e-324, 0.0], [1.0, 0.0]],
+], ids=["subnormal", "tiny", "one-subnormal-piece"])
+def test_subnormal_pieces_give_an_answer_or_a_clear_error(points, method):
+    # These once sent the adaptive arc-length quadrature into 2^30 bisections (a hang).
+    try:
+        out = mm.resample(np.array(points), 10, method=method, closed=False)
+    except ValueError as error:
+        assert str(error).startswith("points:")
+    else:
+        assert np.isfinite(out).all()

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <cmath>
 #include <string>
 
@@ -88,8 +89,13 @@ class ArcLength {
     const double m = 0.5 * (a + b);
     const double left = rule(i, a, m), right = rule(i, m, b);
     const double both = left + right;
-    // The floor keeps rounding noise from driving the bisection to full depth.
-    if (depth == 0 || std::abs(both - whole) <= std::max(tol, 64.0 * eps * both)) return both;
+    // The floors keep rounding noise from driving the bisection to full depth, which is 2^depth
+    // rules: relative noise, and the absolute noise of pieces so short that their lengths are
+    // subnormal numbers (the relative tolerance is zero there).
+    const double floor = std::max(64.0 * eps * both, 64.0 * std::numeric_limits<double>::min());
+    // A non-finite speed (pieces too short for their slopes to be represented) cannot converge:
+    // the caller rejects the length.
+    if (depth == 0 || !std::isfinite(both) || std::abs(both - whole) <= std::max(tol, floor)) return both;
     return adapt(i, a, m, left, 0.5 * tol, depth - 1) +
            adapt(i, m, b, right, 0.5 * tol, depth - 1);
   }
@@ -154,6 +160,10 @@ Points2 resample(const Points2Ref& points, Index n, bool closed, ResampleMethod 
   const Index pieces = curve.pieces();
   if (!std::isfinite(curve.h.sum())) {
     detail::invalid("points", "the curve is too long to measure (its length overflows)");
+  }
+  if (!straight && curve.h.minCoeff() < std::numeric_limits<double>::min()) {
+    detail::invalid("points", "consecutive points too close together to fit a curve through them (closer "
+                              "than the smallest normal double)");
   }
 
   // Length of each piece, then cumulative lengths with compensated summation so that the
