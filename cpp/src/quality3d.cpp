@@ -106,12 +106,12 @@ Points3 normals_under(const Points3Ref& points, const FacesRef& faces, const std
   for (Index j = 0; j < faces.rows(); ++j) {
     if (use[j]) triangles.push_back(j);
   }
+  if (triangles.empty()) return nu;
   Points3 centroids(triangles.size(), 3);
   for (std::size_t k = 0; k < triangles.size(); ++k) {
     const Index j = triangles[k];
     centroids.row(k) = (points.row(faces(j, 0)) + points.row(faces(j, 1)) + points.row(faces(j, 2))) / 3.0;
   }
-  if (triangles.empty()) return nu;
   const IndexVector hit = index.closest_points(centroids).faces;
   for (std::size_t k = 0; k < triangles.size(); ++k) {
     const Index j = triangles[k];

@@ -85,12 +85,30 @@ void mark_odd_nesting(Cdt& cdt) {
 }
 
 
+// The points (x, y pairs) that lie at least away[k] from every loop.
+std::vector<Point> clear_of_loops(const std::vector<CurveIndex>& loops, const std::vector<double>& xy,
+                                  const std::vector<double>& away) {
+  const Index count = static_cast<Index>(away.size());
+  const Eigen::Map<const Points2> points(xy.data(), count, 2);
+  std::vector<double> distance(away.size(), std::numeric_limits<double>::infinity());
+  for (const CurveIndex& loop : loops) {
+    const CurveHits hits = loop.closest_points(points);
+    for (Index k = 0; k < count; ++k) distance[k] = std::min(distance[k], hits.distances[k]);
+  }
+  std::vector<Point> kept;
+  for (Index k = 0; k < count; ++k) {
+    if (distance[k] >= away[k]) kept.emplace_back(points(k, 0), points(k, 1));
+  }
+  return kept;
+}
+
 // Interior vertices from a triangular lattice of spacing `edge` (equilateral triangles, the best
 // shape for P1): its points inside an odd number of loops (scan line by scan line, as the region
 // is defined) and at least `clearance` times the spacing from the loops. Seeding them at once and
 // leaving the mesher only the strip along the loops is several times faster than growing the whole
 // mesh by refinement, one circumcentre at a time.
-std::vector<Point> lattice_points(const std::vector<Points2>& loops, double edge, double clearance) {
+std::vector<Point> lattice_points(const std::vector<Points2>& loops, const std::vector<CurveIndex>& indexes,
+                                  double edge, double clearance) {
   const double row = edge * std::sqrt(3.0) / 2.0;
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (const Points2& loop : loops) lo = std::min(lo, loop.col(1).minCoeff()), hi = std::max(hi, loop.col(1).maxCoeff());
@@ -128,18 +146,8 @@ std::vector<Point> lattice_points(const std::vector<Points2>& loops, double edge
       }
     }
   }
-  const Index n = static_cast<Index>(candidates.size() / 2);
-  const Eigen::Map<const Points2> points(candidates.data(), n, 2);
-  std::vector<double> distance(static_cast<std::size_t>(n), std::numeric_limits<double>::infinity());
-  for (const Points2& loop : loops) {
-    const CurveHits hits = CurveIndex(loop, true).closest_points(points);
-    for (Index k = 0; k < n; ++k) distance[k] = std::min(distance[k], hits.distances[k]);
-  }
-  std::vector<Point> kept;
-  for (Index k = 0; k < n; ++k) {
-    if (distance[k] >= clearance * edge) kept.emplace_back(points(k, 0), points(k, 1));
-  }
-  return kept;
+  const std::vector<double> away(candidates.size() / 2, clearance * edge);
+  return clear_of_loops(indexes, candidates, away);
 }
 
 // Graded layers between the loops' points and the lattice: layer k keeps every 2^k-th point of a
@@ -149,7 +157,8 @@ std::vector<Point> lattice_points(const std::vector<Points2>& loops, double edge
 // grades a strip a lattice spacing wide down to the points' spacing on its own, inserting into
 // fans of long thin triangles, and its time grew superlinearly (confocal ellipses, 10^5 points
 // per curve: 6.7 s against 2.8 s with the layers).
-std::vector<Point> layer_points(const Cdt& cdt, const std::vector<Points2>& loops, double limit) {
+std::vector<Point> layer_points(const Cdt& cdt, const std::vector<Points2>& loops,
+                                const std::vector<CurveIndex>& indexes, double limit) {
   std::vector<double> xy, away;
   Cdt::Face_handle hint;
   for (const Points2& loop : loops) {
@@ -176,18 +185,8 @@ std::vector<Point> layer_points(const Cdt& cdt, const std::vector<Points2>& loop
       }
     }
   }
-  const Index count = static_cast<Index>(away.size());
-  const Eigen::Map<const Points2> points(xy.data(), count, 2);
-  std::vector<double> distance(away.size(), std::numeric_limits<double>::infinity());
-  for (const Points2& loop : loops) {
-    const CurveHits hits = CurveIndex(loop, true).closest_points(points);
-    for (Index k = 0; k < count; ++k) distance[k] = std::min(distance[k], hits.distances[k]);
-  }
-  std::vector<Point> kept;
-  for (Index k = 0; k < count; ++k) {
-    if (distance[k] >= 0.7 * away[k]) kept.emplace_back(points(k, 0), points(k, 1));
-  }
-  return kept;
+  for (double& d : away) d *= 0.7;
+  return clear_of_loops(indexes, xy, away);
 }
 
 }  // namespace
@@ -213,6 +212,15 @@ RegionMesh mesh_region(const std::vector<Points2>& loops, double max_edge) {
       handles[i] = v;
       hint = v->face();
     }
+    if (max_edge > 0) {  // the split edges below must not run away either
+      double pieces = 0.0;
+      for (const Points2& loop : loops) {
+        for (Index i = 0; i < loop.rows(); ++i) {
+          pieces += std::ceil((loop.row((i + 1) % loop.rows()) - loop.row(i)).norm() / max_edge);
+        }
+      }
+      if (!(pieces <= static_cast<double>(kMaxVertices))) too_many_vertices();
+    }
     Index first = 0;
     for (const Points2& loop : loops) {
       const Index n = loop.rows();
@@ -221,7 +229,7 @@ RegionMesh mesh_region(const std::vector<Points2>& loops, double max_edge) {
         if (a == b) continue;
         // Edges longer than the mesh size are split evenly beforehand, as the mesher would.
         const double length = std::sqrt(CGAL::squared_distance(a->point(), b->point()));
-        const int pieces = max_edge > 0 ? static_cast<int>(std::min(std::ceil(length / max_edge), 1e6)) : 1;
+        const int pieces = max_edge > 0 ? static_cast<int>(std::ceil(length / max_edge)) : 1;
         auto previous = a;
         for (int k = 1; k < pieces; ++k) {
           const double t = static_cast<double>(k) / pieces;
@@ -239,9 +247,11 @@ RegionMesh mesh_region(const std::vector<Points2>& loops, double max_edge) {
     if (cdt.dimension() < 2) throw GeometryError("the region between the curves is empty");
     if (max_edge > 0) {
       // A little under the bound, so that rounding does not make the mesher split lattice edges.
-      std::vector<Point> seeds = lattice_points(loops, 0.97 * max_edge, kClearance);
+      std::vector<CurveIndex> indexes;
+      for (const Points2& loop : loops) indexes.emplace_back(loop, true);
+      std::vector<Point> seeds = lattice_points(loops, indexes, 0.97 * max_edge, kClearance);
       mark_odd_nesting(cdt);  // layer_points keeps the points on the region's side
-      const std::vector<Point> layers = layer_points(cdt, loops, 0.9 * kClearance * max_edge);
+      const std::vector<Point> layers = layer_points(cdt, loops, indexes, 0.9 * kClearance * max_edge);
       seeds.insert(seeds.end(), layers.begin(), layers.end());
       CGAL::spatial_sort(seeds.begin(), seeds.end(), Kernel());
       Cdt::Face_handle hint;

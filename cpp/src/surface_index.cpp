@@ -63,6 +63,12 @@ void prefetch(const T* p, bool write = false) {
 #endif
 }
 
+void store(SurfaceHits& hits, Index i, const Hit& hit) {
+  hits.points.row(i) = hit.point.transpose();
+  hits.distances[i] = hit.face >= 0 ? hit.distance : kNaN;
+  hits.faces[i] = hit.face;
+}
+
 // Nearer the origin first, then the positive side, then the lower face.
 bool line_hit_before(double t, Index face, const Hit& best) {
   if (best.face < 0) return true;
@@ -266,9 +272,7 @@ struct SurfaceIndex::Impl {
       for (int i = 0; i < n; ++i) {
         if (face[i] >= 0) refine(o[i], u[i], face[i], best[i]);
         if (best[i].face >= 0) best[i].point = o[i] + best[i].distance * u[i];
-        hits.points.row(row[i]) = best[i].point.transpose();
-        hits.distances[row[i]] = best[i].face >= 0 ? best[i].distance : kNaN;
-        hits.faces[row[i]] = best[i].face;
+        store(hits, row[i], best[i]);
       }
     }
   }
@@ -352,12 +356,6 @@ SurfaceHits allocate_hits(Index rows) {
   hits.distances.resize(rows);
   hits.faces.resize(rows);
   return hits;
-}
-
-void store(SurfaceHits& hits, Index i, const Hit& hit) {
-  hits.points.row(i) = hit.point.transpose();
-  hits.distances[i] = hit.face >= 0 ? hit.distance : kNaN;
-  hits.faces[i] = hit.face;
 }
 
 }  // namespace
