@@ -13,7 +13,8 @@
 
 namespace morphomap::detail {
 
-enum Kind : char { free_vertex = 0, source_vertex = 1, target_vertex = 2 };
+// crossing_vertex: on both surfaces, where they cross; c = 0 there.
+enum Kind : char { free_vertex = 0, source_vertex = 1, target_vertex = 2, crossing_vertex = 3 };
 
 // elements: (E, K) vertex indices; local(e) returns element e's K x K stiffness matrix. With
 // iterative, conjugate gradients with an incomplete Cholesky preconditioner come first (less

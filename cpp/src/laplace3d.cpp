@@ -1,5 +1,6 @@
 // Diffusion mapping in 3D: P1 finite elements for the Laplace equation on the tetrahedral mesh of
-// the shell between two closed surfaces, and streamlines of the recovered gradient.
+// the region between two closed surfaces (a shell, or the pieces of the symmetric difference of
+// crossing surfaces), and streamlines of the recovered gradient.
 #include <morphomap/errors.hpp>
 #include <morphomap/laplace3d.hpp>
 #include <morphomap/surface_queries.hpp>
@@ -18,6 +19,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -31,6 +33,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 using detail::free_vertex;
 using detail::source_vertex;
 using detail::target_vertex;
+using detail::crossing_vertex;
 
 struct SurfaceFacts {
   double volume = 0.0;  // signed: positive when the faces are oriented outwards
@@ -83,7 +86,7 @@ Vector solve_potential(const detail::ShellMesh& mesh, const std::vector<char>& k
 // one or leaves the mesh through a face of the target.
 class Tracer {
  public:
-  Tracer(const detail::ShellMesh& mesh, const Vector& c, const std::vector<char>& kind) : mesh_(mesh) {
+  Tracer(const detail::ShellMesh& mesh, const Vector& c, const std::vector<char>& kind) : mesh_(mesh), c_(c) {
     const Index n = mesh.vertices.rows(), tets = mesh.tetrahedra.rows();
     velocity_.assign(n, Vec3::Zero());
     std::vector<double> weight(n, 0.0);
@@ -116,11 +119,27 @@ class Tracer {
       if (weight[v] > 0.0) velocity_[v] /= weight[v];
     }
     recover_by_least_squares(c);
+    // Where the surfaces cross, c jumps from 1 to 0 along a curve and no smooth fit holds: in the
+    // tetrahedra at such a curve the flow is the element's own -grad c (the P1 field), which
+    // points away from the source faces and out through the target faces.
+    element_flow_.assign(tets, Vec3::Constant(kNaN));
+    for (Index t = 0; t < tets; ++t) {
+      bool at_crossing = false;
+      for (int i = 0; i < 4; ++i) at_crossing = at_crossing || kind[mesh.tetrahedra(t, i)] == crossing_vertex;
+      if (!at_crossing) continue;
+      gradients(mesh.vertices, mesh.tetrahedra, t, g);
+      Vec3 flow = Vec3::Zero();
+      for (int i = 0; i < 4; ++i) flow -= c[mesh.tetrahedra(t, i)] * g.row(i).transpose();
+      element_flow_[t] = flow;
+    }
     for (Index v = 0; v < n; ++v) {
-      // On the surfaces c is constant, so the flow is normal to them.
-      if (kind[v] != free_vertex && normal[v].squaredNorm() > 0.0) {
-        const Vec3 unit = normal[v].normalized();
-        velocity_[v] = velocity_[v].dot(unit) * unit;
+      // On the surfaces c is constant, so the flow is normal to them: into the region at the
+      // source (c = 1 is its maximum), out of it at the target. The fit only gives the speed (its
+      // sign may be wrong near a crossing curve, where c jumps).
+      if ((kind[v] == source_vertex || kind[v] == target_vertex) && normal[v].squaredNorm() > 0.0) {
+        const Vec3 outwards = normal[v].normalized();
+        const double speed = std::abs(velocity_[v].dot(outwards));
+        velocity_[v] = (kind[v] == source_vertex ? -speed : speed) * outwards;
       }
     }
   }
@@ -130,15 +149,20 @@ class Tracer {
   Vec3 trace(Index t, Vec3 x, std::vector<Vec3>* path) const {
     const Vec3 lost(kNaN, kNaN, kNaN);
     if (path) path->push_back(x);
+    int stalled = 0;
     for (int step = 0; step < kStepLimit; ++step) {
       const double h = step_[t];
       const Vec3 k1 = direction(t, x);
-      if (k1.squaredNorm() == 0.0) return lost;
+      if (k1.squaredNorm() == 0.0) return stopped(locate(t, x), x);
       const Vec3 k2 = direction(t, x + 0.5 * h * k1), k3 = direction(t, x + 0.5 * h * k2),
                  k4 = direction(t, x + h * k3);
       const Vec3 y = x + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+      const Vec3 before = x;
       const int outcome = walk(t, x, y);
       if (path) path->push_back(x);
+      // Pressed against a boundary that is not the target, a streamline stops moving.
+      stalled = x == before ? stalled + 1 : 0;
+      if (stalled == kStallLimit) return stopped(t, x);
       if (outcome == reached_target) return x;
       if (outcome == lost_way) return lost;
     }
@@ -149,8 +173,19 @@ class Tracer {
   enum Outcome { inside = 0, reached_target = 1, lost_way = 2 };
   static constexpr int kStepLimit = 100000;
   static constexpr int kWalkLimit = 10000;
+  static constexpr int kStallLimit = 16;
 
   Vec3 point(Index v) const { return mesh_.vertices.row(v).transpose(); }
+
+  // Where a streamline that stopped moving at x in tetrahedron t ends: at x if t touches a curve
+  // where the surfaces cross (the streamline has run into the curve, a point of the target) or
+  // has c = 0 at every corner (it is at the target's level), else nowhere (NaN).
+  Vec3 stopped(Index t, const Vec3& x) const {
+    bool level_zero = true;
+    for (int i = 0; i < 4; ++i) level_zero = level_zero && c_[mesh_.tetrahedra(t, i)] == 0.0;
+    if (level_zero || !std::isnan(element_flow_[t].x())) return x;
+    return Vec3::Constant(kNaN);
+  }
 
   // The volume-weighted mean of the element gradients is only first-order accurate on an
   // irregular mesh. Better: fit a quadratic to the nodal values around each vertex (its
@@ -225,9 +260,12 @@ class Tracer {
 
   Vec3 direction(Index t, const Vec3& x) const {
     t = locate(t, x);
-    const Vec4 l = barycentric(t, x);
-    Vec3 u = Vec3::Zero();
-    for (int i = 0; i < 4; ++i) u += l[i] * velocity_[mesh_.tetrahedra(t, i)];
+    Vec3 u = element_flow_[t];
+    if (std::isnan(u.x())) {
+      const Vec4 l = barycentric(t, x);
+      u.setZero();
+      for (int i = 0; i < 4; ++i) u += l[i] * velocity_[mesh_.tetrahedra(t, i)];
+    }
     const double norm = u.norm();
     return norm > 0.0 ? Vec3(u / norm) : Vec3::Zero();
   }
@@ -273,7 +311,9 @@ class Tracer {
   }
 
   const detail::ShellMesh& mesh_;
-  std::vector<Vec3> velocity_;  // recovered -grad c at the vertices
+  const Vector& c_;
+  std::vector<Vec3> velocity_;      // recovered -grad c at the vertices
+  std::vector<Vec3> element_flow_;  // -grad c of the tetrahedra at a crossing curve, else NaN
   std::vector<double> step_;    // RK4 step length in each tetrahedron
 };
 
@@ -299,19 +339,22 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
   auto clock = std::chrono::steady_clock::now();
   const detail::Nesting nesting =
       detail::classify_nesting(source_vertices, source_out, target_vertices, target_out);
-  if (nesting == detail::Nesting::crossing) {
-    throw InvalidInput("s2: diffusion mapping of crossing surfaces is not supported yet");
-  }
   if (nesting == detail::Nesting::disjoint) {
-    throw InvalidInput("s2: diffusion mapping needs one surface inside the other (these lie apart)");
+    throw InvalidInput("s2: diffusion mapping needs surfaces that overlap (these lie apart)");
   }
-  const bool source_inside = nesting == detail::Nesting::source_inside;
+  std::unique_ptr<detail::CrossingRegion> crossing;
+  if (nesting == detail::Nesting::crossing) {
+    crossing = std::make_unique<detail::CrossingRegion>(source_vertices, source_out, target_vertices, target_out);
+  }
 
   // Sizes: the input spacing at each surface, growing by a tenth of the distance from it, never
-  // above mesh_size (default: a quarter of the mean gap, the shell's volume over its mean area).
-  // Measured between spheres of radii 1 and 4: the end-point error falls about linearly with the
-  // element size in the bulk, and removing slivers (exude) buys more accuracy than it costs time.
-  const double gap = std::abs(std::abs(target.volume) - std::abs(source.volume)) / (0.5 * (source.area + target.area));
+  // above mesh_size (default: a quarter of the mean gap, the region's volume over the mean area of
+  // the surfaces). Measured between spheres of radii 1 and 4: the end-point error falls about
+  // linearly with the element size in the bulk, and removing slivers (exude) buys more accuracy
+  // than it costs time.
+  const double gap = crossing ? crossing->volume() / (0.5 * crossing->area())
+                              : std::abs(std::abs(target.volume) - std::abs(source.volume)) /
+                                    (0.5 * (source.area + target.area));
   detail::ShellMeshCriteria criteria;
   criteria.cell_size = options.mesh_size > 0.0 ? options.mesh_size : 0.25 * gap;
   criteria.source_size = std::min(source.mean_edge, criteria.cell_size);
@@ -320,7 +363,9 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
   criteria.exude = true;
   criteria.facet_distance = 0.05 * std::min(criteria.source_size, criteria.target_size);
   const detail::ShellMesh mesh =
-      detail::mesh_shell(source_vertices, source_out, target_vertices, target_out, source_inside, criteria);
+      crossing ? crossing->mesh(criteria)
+               : detail::mesh_shell(source_vertices, source_out, target_vertices, target_out,
+                                    nesting == detail::Nesting::source_inside, criteria);
 
   ShellDiffusionSolution solution;
   solution.seconds.mesh = seconds_since(clock);
@@ -335,7 +380,9 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
       if (patch != detail::source_face && patch != detail::target_face) continue;
       if (patch == detail::source_face) source_facets.push_back(4 * t + i);
       for (int j = 1; j < 4; ++j) {
-        kind[mesh.tetrahedra(t, (i + j) % 4)] = patch == detail::source_face ? source_vertex : target_vertex;
+        char& k = kind[mesh.tetrahedra(t, (i + j) % 4)];
+        const char here = patch == detail::source_face ? source_vertex : target_vertex;
+        k = k == free_vertex || k == here ? here : static_cast<char>(crossing_vertex);
       }
     }
   }

@@ -4,9 +4,12 @@
 // it compiles for minutes.
 #include <morphomap/types.hpp>
 
+#include <memory>
+
 namespace morphomap::detail {
 
-// How two closed, outward-oriented surfaces lie relative to each other.
+// How two closed, outward-oriented surfaces lie relative to each other. Throws InvalidInput if
+// either intersects itself.
 enum class Nesting { source_inside, target_inside, disjoint, crossing };
 Nesting classify_nesting(const Points3Ref& source_vertices, const FacesRef& source_faces,
                          const Points3Ref& target_vertices, const FacesRef& target_faces);
@@ -37,6 +40,30 @@ struct ShellMesh {
 ShellMesh mesh_shell(const Points3Ref& source_vertices, const FacesRef& source_faces,
                      const Points3Ref& target_vertices, const FacesRef& target_faces, bool source_inside,
                      const ShellMeshCriteria& criteria);
+
+// The symmetric difference of two crossing closed surfaces: each surface cut along the curves
+// where they cross (CGAL's corefinement) into patches that lie inside or outside the other. The
+// pieces are S1 \ S2 (between the parts of S1 outside S2 and of S2 inside S1) and S2 \ S1.
+class CrossingRegion {
+ public:
+  // Both surfaces closed, consistently oriented outwards, free of self-intersections and crossing
+  // (classify_nesting). Throws InvalidInput if the two coincide over a patch.
+  CrossingRegion(const Points3Ref& source_vertices, const FacesRef& source_faces,
+                 const Points3Ref& target_vertices, const FacesRef& target_faces);
+  ~CrossingRegion();
+  CrossingRegion(const CrossingRegion&) = delete;
+  CrossingRegion& operator=(const CrossingRegion&) = delete;
+
+  double volume() const;  // of all the pieces together
+  double area() const;    // of both surfaces together
+  // Tetrahedra of every piece (subdomains 1: S1 \ S2 and 2: S2 \ S1); the curves where the
+  // surfaces cross are protected as mesh edges. Throws GeometryError if Mesh_3 fails.
+  ShellMesh mesh(const ShellMeshCriteria& criteria) const;
+
+ private:
+  struct Patches;
+  std::unique_ptr<Patches> patches_;
+};
 
 struct TriangleHits {
   Points3 points;     // closest point on the triangles

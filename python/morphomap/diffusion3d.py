@@ -1,4 +1,4 @@
-"""Diffusion mapping in 3D: the Laplace problem in the shell between two closed surfaces."""
+"""Diffusion mapping in 3D: the Laplace problem in the region between two closed surfaces."""
 
 from __future__ import annotations
 
@@ -14,10 +14,10 @@ from .surfaces import as_surface
 
 @dataclass(frozen=True)
 class ShellDiffusionSolution:
-    """The Laplace problem between two nested closed surfaces, solved.
+    """The Laplace problem between two closed surfaces, solved.
 
     vertices : (V, 3) float and tetrahedra : (T, 4) int64
-        The tetrahedral mesh of the shell (CGAL Mesh_3, positively oriented). Its boundary
+        The tetrahedral mesh of the region (CGAL Mesh_3, positively oriented). Its boundary
         approximates the surfaces; their vertices are not mesh vertices.
     potential : (V,) float
         c at the vertices: P1 finite elements with c = 1 on S1 and c = 0 on S2.
@@ -54,10 +54,13 @@ def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False) -> ShellDif
     Parameters
     ----------
     s1, s2 : trimesh.Trimesh or (vertices, faces)
-        Closed, consistently oriented triangle surfaces, one inside the other (either way round).
-        Crossing surfaces are not supported yet.
+        Closed, consistently oriented triangle surfaces without self-intersections. Either one
+        lies inside the other (the region is the shell between them) or they cross: then the
+        region is both pieces of their symmetric difference (S1 outside S2, bounded by that part
+        of S1 and the part of S2 inside S1; and S2 outside S1), meshed with the crossing curves
+        as edges, where c = 0. Surfaces that lie apart or coincide over a patch raise ValueError.
     mesh_size : float, optional
-        Largest tetrahedron size. Default: a quarter of the mean gap (the shell's volume over the
+        Largest tetrahedron size. Default: a quarter of the mean gap (the region's volume over the
         mean area of the surfaces). Near each surface the mesh follows its mean edge length (or
         ``mesh_size`` if smaller) and grows by a tenth of the distance away from it.
     streamlines : bool

@@ -121,7 +121,8 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False) -> DisplacementField
         ``"normal"``: the line through each vertex along its angle-weighted normal, both
         directions, to its nearest intersection with ``s2``; NaN where it meets nothing.
         ``"diffusion"``: streamlines of Laplace's equation in the region between the surfaces
-        (c = 1 on S1, 0 on S2) from each vertex to S2.
+        (c = 1 on S1, 0 on S2) from each vertex to S2; nested or crossing surfaces (see
+        :func:`solve_diffusion_3d`), without self-intersections.
         ``"auto"``: normal mapping; if a normal misses or a triangle's image is turned over (see
         :func:`quality`, ``folds``), reverse diffusion for the whole surface instead (the field
         then starts from the vertices of ``s2``; ``field.method`` tells).

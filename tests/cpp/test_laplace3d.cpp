@@ -155,14 +155,35 @@ void sphere_to_ellipsoid() {
   }
 }
 
+// Crossing surfaces: the unit sphere and an ellipsoid through it. Each start outside the
+// ellipsoid bounds the piece sphere \ ellipsoid, so its end lies on the ellipsoid inside the
+// sphere, and the other way round.
+void crossing_surfaces() {
+  const Surface sphere = icosphere(3);
+  Surface ellipsoid = scaled(icosphere(3), 1.3, 1.0, 1.0);
+  const Eigen::RowVector3d centre(0.6, 0.05, 0.03), axes(1.3, 1.0, 1.0);
+  ellipsoid.vertices.rowwise() += centre;
+  const auto solution = solve_diffusion_3d(sphere.vertices, sphere.faces, ellipsoid.vertices, ellipsoid.faces);
+  CHECK(solution.ends.allFinite());
+  int outside = 0;
+  for (Index i = 0; i < solution.ends.rows(); ++i) {
+    const Eigen::RowVector3d start = sphere.vertices.row(i), end = solution.ends.row(i);
+    CHECK_NEAR((end - centre).cwiseQuotient(axes).norm(), 1.0, 0.01);
+    const bool start_outside = (start - centre).cwiseQuotient(axes).norm() > 1.0;
+    outside += start_outside;
+    CHECK(start_outside ? end.norm() < 1.01 : end.norm() > 0.99);
+  }
+  CHECK(outside > 100 && outside < solution.ends.rows() - 100);
+}
+
 void bad_input() {
   const Surface a = icosphere(1), b = scaled(icosphere(1), 3, 3, 3);
   Surface apart = a;
   apart.vertices.col(0).array() += 5.0;
   CHECK_THROWS(solve_diffusion_3d(a.vertices, a.faces, apart.vertices, apart.faces), InvalidInput);
-  Surface crossing = a;
-  crossing.vertices.col(0).array() += 0.5;
-  CHECK_THROWS(solve_diffusion_3d(a.vertices, a.faces, crossing.vertices, crossing.faces), InvalidInput);
+  Surface self_crossing = b;
+  self_crossing.vertices.row(0) *= -1.5;  // a spike through the far side
+  CHECK_THROWS(solve_diffusion_3d(a.vertices, a.faces, self_crossing.vertices, self_crossing.faces), InvalidInput);
   Surface open = b;
   open.faces.conservativeResize(open.faces.rows() - 1, 3);
   CHECK_THROWS(solve_diffusion_3d(a.vertices, a.faces, open.vertices, open.faces), InvalidInput);
@@ -187,5 +208,6 @@ int main() {
   concentric_spheres();
   inwards_and_flipped();
   sphere_to_ellipsoid();
+  crossing_surfaces();
   TEST_MAIN_END();
 }

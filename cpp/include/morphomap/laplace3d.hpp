@@ -8,7 +8,7 @@ namespace morphomap {
 
 struct ShellDiffusionOptions {
   // Largest tetrahedron size (CGAL Mesh_3 cell size); 0: a quarter of the mean gap between the
-  // surfaces (the shell's volume over the mean of their areas). Near each surface the mesh follows
+  // surfaces (the region's volume over the mean of their areas). Near each surface the mesh follows
   // its mean edge length (or mesh_size, if smaller) and grows away from it by a tenth of the
   // distance.
   double mesh_size = 0.0;
@@ -34,9 +34,10 @@ struct ShellDiffusionSolution {
 };
 
 // Both surfaces closed, edge-manifold and consistently oriented (either way round). The region: the
-// shell between them when one lies inside the other (which one is found). Crossing surfaces (each
-// piece of the symmetric difference on its own) are not supported yet: InvalidInput, as for
-// surfaces that lie apart. Streamlines start on the mesh boundary at the closest point to each
+// shell between them when one lies inside the other (which one is found); when they cross, the
+// pieces of their symmetric difference (S1 outside S2, S2 outside S1), each bounded by parts of
+// both, meshed together with the crossing curves as mesh edges (c = 0 on them). Surfaces that lie
+// apart, intersect themselves or coincide over a patch: InvalidInput. Streamlines start on the mesh boundary at the closest point to each
 // source vertex and follow the recovered, linearly interpolated -grad c in RK4 steps; where one
 // leaves the mesh through the target boundary, its end is moved to the closest point of the
 // target surface.
