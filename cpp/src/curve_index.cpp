@@ -8,7 +8,13 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#if defined(__SSE2__) || defined(_M_X64)
+#include <emmintrin.h>  // SSE2 is part of x86-64: no run-time dispatch needed
+#define MORPHOMAP_SSE2 1
+#endif
+
 #include <algorithm>
+#include <cstring>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -53,6 +59,112 @@ static_assert(kLeafSize < 8, "a leaf reference keeps its count in 3 bits");
 
 std::int64_t leaf_ref(std::int32_t first, std::int32_t count) { return ~(std::int64_t{first} * 8 + count); }
 
+// The same tree for line queries, with the boxes in float32 and in a normalised frame (the curve's
+// bounding box centred on 0 and scaled by a power of 2 into [-1, 1]^2), so that a node's four
+// boxes are tested in one SSE register. Each float box contains its segments exactly (its
+// extents are fitted around the float centre and axis and rounded outward); `slack` is an upper
+// bound, scaled from the box's magnitudes, on the rounding of the float test, so the test never
+// culls a box that a line meets. Unused slots have NaN extents, which no comparison passes.
+// child: an inner node's index, or ~(block index) for a leaf.
+struct alignas(64) LineNode {
+  float cx[kWidth], cy[kWidth], ax[kWidth], ay[kWidth], hu[kWidth], hv[kWidth], slack[kWidth];
+  std::int32_t child[kWidth];
+};
+static_assert(sizeof(LineNode) == 128, "two cache lines");
+
+// A leaf's segments side by side (padded to kLeafSize with copies of its last one, which can only
+// tie with it), so that the crossing tests run two at a time.
+struct alignas(16) LeafBlock {
+  double ax[kLeafSize], ay[kLeafSize], ex[kLeafSize], ey[kLeafSize];
+  std::int32_t segment[kLeafSize];  // index in `segments`
+};
+static_assert(kLeafSize == 4, "the leaf test runs two pairs");
+
+// Relative bound on the rounding of the float box test: its terms have a few float roundings
+// (2^-24) each and the inputs one more; 4e-6 is ~60 ulps, far above the error, far below a box.
+constexpr double kFloatSlack = 4e-6;
+
+float float_up(double x) {
+  float f = static_cast<float>(x);
+  if (static_cast<double>(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+  return f;
+}
+
+// Four floats: SSE2, or plain arrays where SSE2 is missing. A comparison gives a lane mask.
+#ifdef MORPHOMAP_SSE2
+struct F4 {
+  __m128 v;
+  static F4 load(const float* p) { return {_mm_load_ps(p)}; }
+  static F4 all(float x) { return {_mm_set1_ps(x)}; }
+  friend F4 operator+(F4 a, F4 b) { return {_mm_add_ps(a.v, b.v)}; }
+  friend F4 operator-(F4 a, F4 b) { return {_mm_sub_ps(a.v, b.v)}; }
+  friend F4 operator*(F4 a, F4 b) { return {_mm_mul_ps(a.v, b.v)}; }
+  friend F4 operator&(F4 a, F4 b) { return {_mm_and_ps(a.v, b.v)}; }
+  friend F4 abs(F4 a) { return {_mm_andnot_ps(_mm_set1_ps(-0.0f), a.v)}; }
+  friend F4 max(F4 a, F4 b) { return {_mm_max_ps(a.v, b.v)}; }
+  friend F4 le(F4 a, F4 b) { return {_mm_cmple_ps(a.v, b.v)}; }  // false for NaN
+  friend int bits(F4 mask) { return _mm_movemask_ps(mask.v); }
+};
+
+// The four children as sort keys, nearest first: the bound (at least FLT_MIN, so that no key is
+// subnormal, and with its last two bits cleared, which only lowers it) with the lane in those
+// bits; children not kept get the largest finite float. Positive floats order as their bits, so
+// a min/max network sorts them (three rounds of two compare-exchanges).
+void sorted_keys(F4 bound, F4 keep, std::int32_t* out) {
+  const __m128i lane = _mm_set_epi32(3, 2, 1, 0);
+  const __m128i low = _mm_set1_epi32(3);
+  __m128i key = _mm_castps_si128(_mm_max_ps(bound.v, _mm_set1_ps(std::numeric_limits<float>::min())));
+  key = _mm_andnot_si128(low, key);
+  const __m128i far = _mm_castps_si128(_mm_set1_ps(std::numeric_limits<float>::max()));
+  const __m128i mask = _mm_castps_si128(keep.v);
+  key = _mm_or_si128(_mm_or_si128(_mm_and_si128(mask, key), _mm_andnot_si128(mask, _mm_andnot_si128(low, far))), lane);
+  __m128 k = _mm_castsi128_ps(key);
+  // (0 1) (2 3) -> [min01 min23 max01 max23]; again -> [min, ., ., max]; then the middle pair.
+  for (int round = 0; round < 2; ++round) {
+    const __m128 other = _mm_shuffle_ps(k, k, _MM_SHUFFLE(2, 3, 0, 1));
+    k = _mm_shuffle_ps(_mm_min_ps(k, other), _mm_max_ps(k, other), _MM_SHUFFLE(2, 0, 2, 0));
+  }
+  const __m128 other = _mm_shuffle_ps(k, k, _MM_SHUFFLE(3, 1, 2, 0));
+  k = _mm_shuffle_ps(_mm_min_ps(k, other), _mm_max_ps(k, other), _MM_SHUFFLE(3, 2, 1, 0));
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(out), _mm_castps_si128(k));
+}
+#else
+struct F4 {
+  float v[4];
+  static F4 load(const float* p) { return {{p[0], p[1], p[2], p[3]}}; }
+  static F4 all(float x) { return {{x, x, x, x}}; }
+  template <class Op> static F4 map(F4 a, F4 b, Op op) {
+    return {{op(a.v[0], b.v[0]), op(a.v[1], b.v[1]), op(a.v[2], b.v[2]), op(a.v[3], b.v[3])}};
+  }
+  friend F4 operator+(F4 a, F4 b) { return map(a, b, [](float x, float y) { return x + y; }); }
+  friend F4 operator-(F4 a, F4 b) { return map(a, b, [](float x, float y) { return x - y; }); }
+  friend F4 operator*(F4 a, F4 b) { return map(a, b, [](float x, float y) { return x * y; }); }
+  friend F4 operator&(F4 a, F4 b) { return map(a, b, [](float x, float y) { return x != 0 && y != 0 ? 1.0f : 0.0f; }); }
+  friend F4 abs(F4 a) { return {{std::abs(a.v[0]), std::abs(a.v[1]), std::abs(a.v[2]), std::abs(a.v[3])}}; }
+  friend F4 max(F4 a, F4 b) { return map(a, b, [](float x, float y) { return x > y ? x : y; }); }
+  friend F4 le(F4 a, F4 b) { return map(a, b, [](float x, float y) { return x <= y ? 1.0f : 0.0f; }); }
+  friend int bits(F4 mask) {
+    return (mask.v[0] != 0) | (mask.v[1] != 0) << 1 | (mask.v[2] != 0) << 2 | (mask.v[3] != 0) << 3;
+  }
+};
+
+void sorted_keys(F4 bound, F4 keep, std::int32_t* out) {
+  for (int k = 0; k < 4; ++k) {
+    const float b = keep.v[k] != 0 ? std::max(bound.v[k], std::numeric_limits<float>::min())
+                                   : std::numeric_limits<float>::max();
+    std::memcpy(&out[k], &b, sizeof b);
+    out[k] = (out[k] & ~3) | k;
+  }
+  std::sort(out, out + 4);
+}
+#endif
+
+float key_bound(std::int32_t key) {
+  float b;
+  std::memcpy(&b, &key, sizeof b);
+  return b;
+}
+
 // One segment a + s * e, s in [0, 1], stored in leaf order for locality.
 struct Segment {
   double ax, ay, ex, ey;
@@ -87,6 +199,11 @@ struct CurveIndex::Impl {
   bool closed = true;
   std::vector<Segment> segments;
   std::vector<Node> nodes;
+  // Line queries: the same tree in float (LineNode), the leaves as blocks, and the normalised
+  // frame x' = (x - centre) * scale with the curve in [-1, 1]^2.
+  std::vector<LineNode> line_nodes;
+  std::vector<LeafBlock> blocks;
+  double centre_x = 0.0, centre_y = 0.0, scale = 1.0;
 
   Impl(const Points2Ref& curve, bool is_closed) : closed(is_closed) {
     points = detail::require_curve(curve, closed, "curve");
@@ -106,7 +223,23 @@ struct CurveIndex::Impl {
       s.id = i;
       arc += s.length;
     }
+    double lo_x = kInf, lo_y = kInf, hi_x = -kInf, hi_y = -kInf;
+    for (const Segment& s : segments) {
+      lo_x = std::min(lo_x, s.ax), hi_x = std::max(hi_x, s.ax);
+      lo_y = std::min(lo_y, s.ay), hi_y = std::max(hi_y, s.ay);
+    }
+    if (!closed) lo_x = std::min(lo_x, curve(points - 1, 0)), hi_x = std::max(hi_x, curve(points - 1, 0));
+    if (!closed) lo_y = std::min(lo_y, curve(points - 1, 1)), hi_y = std::max(hi_y, curve(points - 1, 1));
+    centre_x = 0.5 * lo_x + 0.5 * hi_x, centre_y = 0.5 * lo_y + 0.5 * hi_y;  // no overflow
+    const double half = std::max({hi_x - centre_x, centre_x - lo_x, hi_y - centre_y, centre_y - lo_y});
+    if (half > 0.0) {
+      int exponent = 0;
+      std::frexp(half, &exponent);  // half < 2^exponent; a subnormal curve is magnified less
+      scale = std::ldexp(1.0, std::min(-exponent, 1000));
+    }
     nodes.reserve(count / kLeafSize + 1);
+    line_nodes.reserve(count / kLeafSize + 1);
+    blocks.reserve(count / 2 + 1);
     build(0, static_cast<std::int32_t>(count));
   }
 
@@ -168,9 +301,57 @@ struct CurveIndex::Impl {
 
   // A node over [begin, end): the range is split (largest part first) into up to four parts;
   // parts of at most kLeafSize segments become leaves, the others nodes of their own.
+  // The float box of segments [begin, end) as child k of line node `nd`, in the normalised frame
+  // and along the double box's axis (or x where that overflowed): the axis is rounded to float,
+  // then the centre fitted and rounded, then the extents fitted around exactly those and rounded
+  // up, with a relative pad for the rounding of the normalised end points and for the leaf
+  // test's 1e-12 slack at segment ends.
+  void fit_line_box(std::int32_t begin, std::int32_t end, double ux, double uy, LineNode& nd, int k) const {
+    if (!std::isfinite(ux) || !std::isfinite(uy)) ux = 1.0, uy = 0.0;
+    const float fax = static_cast<float>(ux), fay = static_cast<float>(uy);
+    const double ax = fax, ay = fay, norm2 = ax * ax + ay * ay;
+    auto for_ends = [&](auto f) {  // f(x, y) over the normalised end points
+      for (std::int32_t i = begin; i < end; ++i) {
+        const Segment& s = segments[i];
+        const double px = (s.ax - centre_x) * scale, py = (s.ay - centre_y) * scale;
+        f(px, py), f(px + s.ex * scale, py + s.ey * scale);
+      }
+    };
+    double lo_u = kInf, hi_u = -kInf, lo_v = kInf, hi_v = -kInf;
+    for_ends([&](double x, double y) {
+      const double pu = (x * ax + y * ay) / norm2, pv = (y * ax - x * ay) / norm2;
+      lo_u = std::min(lo_u, pu), hi_u = std::max(hi_u, pu), lo_v = std::min(lo_v, pv), hi_v = std::max(hi_v, pv);
+    });
+    const double cu = 0.5 * (lo_u + hi_u), cv = 0.5 * (lo_v + hi_v);
+    const float fcx = static_cast<float>(cu * ax - cv * ay), fcy = static_cast<float>(cu * ay + cv * ax);
+    double hu = 0.0, hv = 0.0;
+    for_ends([&](double x, double y) {
+      const double dx = x - fcx, dy = y - fcy;
+      hu = std::max(hu, std::abs(dx * ax + dy * ay) / norm2);
+      hv = std::max(hv, std::abs(dy * ax - dx * ay) / norm2);
+    });
+    const double pad = 1e-6 * (hu + hv) + 1e-14 * (std::abs(fcx) + std::abs(fcy)) + 1e-30;
+    nd.cx[k] = fcx, nd.cy[k] = fcy, nd.ax[k] = fax, nd.ay[k] = fay;
+    nd.hu[k] = float_up(hu + pad), nd.hv[k] = float_up(hv + pad);
+    nd.slack[k] = float_up(kFloatSlack * (std::abs(fcx) + std::abs(fcy) + nd.hu[k] + nd.hv[k]) + 1e-30);
+  }
+
+  // The leaf block of segments [begin, end), padded with copies of the last one.
+  std::int32_t make_block(std::int32_t begin, std::int32_t end) {
+    LeafBlock b;
+    for (int k = 0; k < kLeafSize; ++k) {
+      const std::int32_t i = std::min(begin + k, end - 1);
+      const Segment& s = segments[i];
+      b.ax[k] = s.ax, b.ay[k] = s.ay, b.ex[k] = s.ex, b.ey[k] = s.ey, b.segment[k] = i;
+    }
+    blocks.push_back(b);
+    return static_cast<std::int32_t>(blocks.size() - 1);
+  }
+
   std::int64_t build(std::int32_t begin, std::int32_t end) {
     const auto index = static_cast<std::int64_t>(nodes.size());
     nodes.push_back({});
+    line_nodes.push_back({});
     std::int32_t lo[kWidth] = {begin}, hi[kWidth] = {end};
     int parts = 1;
     while (parts < kWidth) {
@@ -185,16 +366,22 @@ struct CurveIndex::Impl {
     }
     for (int k = 0; k < kWidth; ++k) {
       Node& nd = nodes[index];
+      LineNode& ln = line_nodes[index];
       if (k >= parts) {
         nd.cx[k] = nd.cy[k] = nd.uy[k] = nd.hu[k] = nd.hv[k] = 0.0, nd.ux[k] = 1.0, nd.child[k] = kUnused;
+        ln.cx[k] = ln.cy[k] = ln.ay[k] = ln.slack[k] = 0.0f, ln.ax[k] = 1.0f, ln.child[k] = 0;
+        ln.hu[k] = ln.hv[k] = std::numeric_limits<float>::quiet_NaN();
         continue;
       }
       fit_box(lo[k], hi[k], nd, k);
+      fit_line_box(lo[k], hi[k], nd.ux[k], nd.uy[k], ln, k);
       if (hi[k] - lo[k] <= kLeafSize) {
         nd.child[k] = leaf_ref(lo[k], hi[k] - lo[k]);
+        ln.child[k] = ~make_block(lo[k], hi[k]);
       } else {
-        const std::int64_t child = build(lo[k], hi[k]);  // may move `nodes`
+        const std::int64_t child = build(lo[k], hi[k]);  // may move `nodes` and `line_nodes`
         nodes[index].child[k] = child;
+        line_nodes[index].child[k] = static_cast<std::int32_t>(child);
       }
     }
     return index;
@@ -277,56 +464,102 @@ struct CurveIndex::Impl {
     return best;
   }
 
+  // Nearest hit of a whole line: the float tree culls boxes the line misses and boxes whose
+  // nearest |t| exceeds the best hit so far, and orders the rest nearest first; the leaves test
+  // the segments in double.
   Hit line(const Line& l) const {
     Hit best;
-    std::int64_t stack[kStackSize];
-    double bound[kStackSize];
+    // The line in the normalised frame: n . x' = d with n = (-uy, ux); t' = u . x' - e.
+    const double px = (l.ox - centre_x) * scale, py = (l.oy - centre_y) * scale;
+    double d = l.ux * py - l.uy * px, e = l.ux * px + l.uy * py;
+    float line_slack = std::numeric_limits<float>::infinity();
+    if (std::isfinite(d) && std::isfinite(e)) {
+      // The curve lies within sqrt(2) of the frame's origin (d is exact to ~1e-16 (|d| + |e|)).
+      if (std::abs(d) > 4.0 + 1e-6 * (std::abs(d) + std::abs(e))) return best;
+      if (std::abs(e) <= 1e30) line_slack = float_up(kFloatSlack * (std::abs(d) + std::abs(e)));
+    }
+    if (line_slack == std::numeric_limits<float>::infinity()) d = e = 0.0;  // astronomically far: no culling
+    const F4 ux = F4::all(static_cast<float>(l.ux)), uy = F4::all(static_cast<float>(l.uy));
+    const F4 nx = F4::all(static_cast<float>(-l.uy)), ny = ux;
+    const F4 fd = F4::all(static_cast<float>(d)), fe = F4::all(static_cast<float>(e));
+    const F4 fslack = F4::all(line_slack), zero = F4::all(0.0f);
+    // Bounds are compared with the best |t|' rounded up; at least 2^-125, as bounds of 0 are
+    // stored as FLT_MIN (see sorted_keys).
+    float limit = std::numeric_limits<float>::infinity();
+    static constexpr int kCount[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
+    std::int32_t stack[kStackSize];
+    float stack_bound[kStackSize];
     int top = 0;
-    std::int64_t ref = 0;
-    double ref_bound = 0.0;
-    auto beaten = [&best](double b) { return b == kInf || (best.segment && b > std::abs(best.distance)); };
+    std::int32_t ref = 0;
     for (;;) {
-      if (!beaten(ref_bound)) {
-        if (ref < 0) {
-          const std::int64_t code = ~ref;
-          const auto first = static_cast<std::int32_t>(code >> 3), count = static_cast<std::int32_t>(code & 7);
-          for (std::int32_t k = first; k < first + count; ++k) visit(segments[k], l, best);
-        } else {
-          const Node& nd = nodes[ref];
-          double b[kWidth];
-          for (int k = 0; k < kWidth; ++k) {
-            // Smallest |t| of a point of the box on the line, or +inf when the line misses it:
-            // the centre's distance from the line against the box's half width across it, with
-            // slack for rounding so that a line through a corner of the box cannot miss it.
-            // In the box's frame the line's direction is (du, dv).
-            const double cx = nd.cx[k] - l.ox, cy = nd.cy[k] - l.oy;
-            const double du = std::abs(l.ux * nd.ux[k] + l.uy * nd.uy[k]);
-            const double dv = std::abs(l.uy * nd.ux[k] - l.ux * nd.uy[k]);
-            const double across = std::abs(l.ux * cy - l.uy * cx);
-            const double slack = 1e-12 * (std::abs(cx) + std::abs(cy) + nd.hu[k] + nd.hv[k]);
-            const double along = l.ux * cx + l.uy * cy, reach = du * nd.hu[k] + dv * nd.hv[k];
-            const double near = std::max(std::abs(along) - reach, 0.0);
-            b[k] = across > dv * nd.hu[k] + du * nd.hv[k] + slack ? kInf : near;
+      if (ref >= 0) {
+        const LineNode& nd = line_nodes[ref];
+        const F4 cx = F4::load(nd.cx), cy = F4::load(nd.cy), ax = F4::load(nd.ax), ay = F4::load(nd.ay);
+        const F4 hu = F4::load(nd.hu), hv = F4::load(nd.hv), slack = F4::load(nd.slack) + fslack;
+        // The line's direction in each box's frame (du along the axis, dv across), the box's
+        // half widths across the line and along it, and its centre's offsets.
+        const F4 du = abs(ux * ax + uy * ay), dv = abs(ux * ay - uy * ax);
+        const F4 across = abs(nx * cx + ny * cy - fd), along = abs(ux * cx + uy * cy - fe);
+        const F4 bound = max(along - (du * hu + dv * hv + slack), zero);
+        const F4 keep = le(across, dv * hu + du * hv + slack) & le(bound, F4::all(limit));
+        const int mask = bits(keep);
+        if (mask != 0) {
+          std::int32_t key[4];
+          sorted_keys(bound, keep, key);
+          // Push all kept children but the nearest, farthest first: three slots written
+          // unconditionally (junk beyond the kept ones), the top moved by kept - 1.
+          const int kept = kCount[mask];
+          for (int j = 0; j < 3; ++j) {
+            const std::int32_t k = key[(kept - 1 - j) & 3];
+            stack[top + j] = nd.child[k & 3], stack_bound[top + j] = key_bound(k);
           }
-          // Not beaten (see `beaten`: a NaN bound is not beaten).
-          const double limit = best.segment ? std::abs(best.distance) : kInf;
-          std::int64_t child[kWidth];
-          int kept = 0;
-          for (int k = 0; k < kWidth; ++k) {
-            const bool keep = b[k] != kInf && !(b[k] > limit) && nd.child[k] != kUnused;
-            kept += keep;
-            // A NaN bound (overflowing boxes) is never beaten, like 0, which also sorts.
-            b[k] = keep ? (b[k] == b[k] ? b[k] : 0.0) : kInf;
-            child[k] = nd.child[k];
-          }
-          if (descend(b, child, kept, stack, bound, top, ref, ref_bound)) continue;
+          top += kept - 1;
+          ref = nd.child[key[0] & 3];
+          continue;
+        }
+      } else {
+        if (visit_block(blocks[~ref], l, best)) {
+          limit = std::max(float_up(std::abs(best.distance) * scale * (1.0 + 1e-9)), 0x1p-125f);
         }
       }
-      if (top == 0) break;
-      --top;
-      ref = stack[top], ref_bound = bound[top];
+      do {
+        if (top == 0) return best;
+        --top;
+      } while (stack_bound[top] > limit);
+      ref = stack[top];
     }
-    return best;
+  }
+
+  // The four segments of a leaf: the crossing test of `visit` (the same operations, so the
+  // same decisions) two at a time; only candidates, and segments parallel to the line, go on to
+  // `visit`. True when the best hit changed.
+  bool visit_block(const LeafBlock& b, const Line& l, Hit& best) const {
+    const Segment* before = best.segment;
+#ifdef MORPHOMAP_SSE2
+    const __m128d ox = _mm_set1_pd(l.ox), oy = _mm_set1_pd(l.oy), ux = _mm_set1_pd(l.ux), uy = _mm_set1_pd(l.uy);
+    const __m128d sign = _mm_set1_pd(-0.0), tiny = _mm_set1_pd(1e-12);
+    int candidates = 0;
+    for (int p = 0; p < kLeafSize; p += 2) {
+      const __m128d wx = _mm_sub_pd(_mm_load_pd(b.ax + p), ox), wy = _mm_sub_pd(_mm_load_pd(b.ay + p), oy);
+      const __m128d ex = _mm_load_pd(b.ex + p), ey = _mm_load_pd(b.ey + p);
+      const __m128d denom = _mm_sub_pd(_mm_mul_pd(ux, ey), _mm_mul_pd(uy, ex));
+      const __m128d along = _mm_sub_pd(_mm_mul_pd(wx, uy), _mm_mul_pd(wy, ux));
+      // along and denom with denom's sign made positive: a segment is rejected where `visit`
+      // rejects it, along < -slack or along > |denom| + slack (a NaN is not rejected).
+      const __m128d flip = _mm_and_pd(denom, sign);
+      const __m128d a = _mm_xor_pd(along, flip), size = _mm_andnot_pd(sign, denom);
+      const __m128d slack = _mm_mul_pd(tiny, size);
+      const __m128d kept = _mm_and_pd(_mm_cmpnlt_pd(a, _mm_xor_pd(slack, sign)),
+                                      _mm_cmpngt_pd(a, _mm_add_pd(size, slack)));
+      candidates |= _mm_movemask_pd(_mm_or_pd(kept, _mm_cmpeq_pd(denom, _mm_setzero_pd()))) << p;
+    }
+    for (int k = 0; k < kLeafSize; ++k) {
+      if (candidates >> k & 1) visit(segments[b.segment[k]], l, best);
+    }
+#else
+    for (int k = 0; k < kLeafSize; ++k) visit(segments[b.segment[k]], l, best);
+#endif
+    return best.segment != before;
   }
 
   // Intersection of the line with one segment; keeps it when it beats the best so far. The
