@@ -106,27 +106,29 @@ struct F4 {
   friend int bits(F4 mask) { return _mm_movemask_ps(mask.v); }
 };
 
-// The four children as sort keys, nearest first: the bound (at least FLT_MIN, so that no key is
-// subnormal, and with its last two bits cleared, which only lowers it) with the lane in those
-// bits; children not kept get the largest finite float. Positive floats order as their bits, so
-// a min/max network sorts them (three rounds of two compare-exchanges).
+// The four children as sort keys, farthest first: the bound (at least FLT_MIN, so that no key
+// is subnormal, with its last two bits cleared, which only lowers it) with the lane in those
+// bits; children not kept get 0, which sorts last. Positive floats order as their bits, so a
+// min/max network sorts them (three rounds of two compare-exchanges). Written to out[0..3].
 void sorted_keys(F4 bound, F4 keep, std::int32_t* out) {
   const __m128i lane = _mm_set_epi32(3, 2, 1, 0);
   const __m128i low = _mm_set1_epi32(3);
-  __m128i key = _mm_castps_si128(_mm_max_ps(bound.v, _mm_set1_ps(std::numeric_limits<float>::min())));
-  key = _mm_andnot_si128(low, key);
-  const __m128i far = _mm_castps_si128(_mm_set1_ps(std::numeric_limits<float>::max()));
-  const __m128i mask = _mm_castps_si128(keep.v);
-  key = _mm_or_si128(_mm_or_si128(_mm_and_si128(mask, key), _mm_andnot_si128(mask, _mm_andnot_si128(low, far))), lane);
+  const __m128i key0 = _mm_castps_si128(bound.v);
+  const __m128i key = _mm_and_si128(_mm_castps_si128(keep.v), _mm_or_si128(_mm_andnot_si128(low, key0), lane));
   __m128 k = _mm_castsi128_ps(key);
-  // (0 1) (2 3) -> [min01 min23 max01 max23]; again -> [min, ., ., max]; then the middle pair.
+  // (0 1) (2 3) -> [max01 max23 min01 min23]; again -> [max, ., ., min]; then the middle pair.
   for (int round = 0; round < 2; ++round) {
     const __m128 other = _mm_shuffle_ps(k, k, _MM_SHUFFLE(2, 3, 0, 1));
-    k = _mm_shuffle_ps(_mm_min_ps(k, other), _mm_max_ps(k, other), _MM_SHUFFLE(2, 0, 2, 0));
+    k = _mm_shuffle_ps(_mm_max_ps(k, other), _mm_min_ps(k, other), _MM_SHUFFLE(2, 0, 2, 0));
   }
   const __m128 other = _mm_shuffle_ps(k, k, _MM_SHUFFLE(3, 1, 2, 0));
-  k = _mm_shuffle_ps(_mm_min_ps(k, other), _mm_max_ps(k, other), _MM_SHUFFLE(3, 2, 1, 0));
+  k = _mm_shuffle_ps(_mm_max_ps(k, other), _mm_min_ps(k, other), _MM_SHUFFLE(3, 2, 1, 0));
   _mm_storeu_si128(reinterpret_cast<__m128i*>(out), _mm_castps_si128(k));
+}
+
+// Four copies of a node index.
+void store4(std::int32_t* out, std::int32_t x) {
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(out), _mm_set1_epi32(x));
 }
 #else
 struct F4 {
@@ -150,13 +152,13 @@ struct F4 {
 
 void sorted_keys(F4 bound, F4 keep, std::int32_t* out) {
   for (int k = 0; k < 4; ++k) {
-    const float b = keep.v[k] != 0 ? std::max(bound.v[k], std::numeric_limits<float>::min())
-                                   : std::numeric_limits<float>::max();
-    std::memcpy(&out[k], &b, sizeof b);
-    out[k] = (out[k] & ~3) | k;
+    std::memcpy(&out[k], &bound.v[k], sizeof(float));
+    out[k] = keep.v[k] != 0 ? (out[k] & ~3) | k : 0;
   }
-  std::sort(out, out + 4);
+  std::sort(out, out + 4, [](std::int32_t x, std::int32_t y) { return x > y; });
 }
+
+void store4(std::int32_t* out, std::int32_t x) { std::fill(out, out + 4, x); }
 #endif
 
 float key_bound(std::int32_t key) {
@@ -482,13 +484,14 @@ struct CurveIndex::Impl {
     const F4 ux = F4::all(static_cast<float>(l.ux)), uy = F4::all(static_cast<float>(l.uy));
     const F4 nx = F4::all(static_cast<float>(-l.uy)), ny = ux;
     const F4 fd = F4::all(static_cast<float>(d)), fe = F4::all(static_cast<float>(e));
-    const F4 fslack = F4::all(line_slack), zero = F4::all(0.0f);
-    // Bounds are compared with the best |t|' rounded up; at least 2^-125, as bounds of 0 are
-    // stored as FLT_MIN (see sorted_keys).
+    const F4 fslack = F4::all(line_slack), least = F4::all(std::numeric_limits<float>::min());
+    // Bounds (at least FLT_MIN, see sorted_keys) are compared with the best |t|' rounded up and
+    // at least 2^-125, above any key of a bound FLT_MIN.
     float limit = std::numeric_limits<float>::infinity();
+    F4 limit4 = F4::all(limit);
     static constexpr int kCount[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
-    std::int32_t stack[kStackSize];
-    float stack_bound[kStackSize];
+    // Waiting children: their key (bound and lane, see sorted_keys) and their parent's index.
+    std::int32_t stack_key[kStackSize], stack_node[kStackSize];
     int top = 0;
     std::int32_t ref = 0;
     for (;;) {
@@ -500,33 +503,30 @@ struct CurveIndex::Impl {
         // half widths across the line and along it, and its centre's offsets.
         const F4 du = abs(ux * ax + uy * ay), dv = abs(ux * ay - uy * ax);
         const F4 across = abs(nx * cx + ny * cy - fd), along = abs(ux * cx + uy * cy - fe);
-        const F4 bound = max(along - (du * hu + dv * hv + slack), zero);
-        const F4 keep = le(across, dv * hu + du * hv + slack) & le(bound, F4::all(limit));
+        const F4 bound = max(along - (du * hu + dv * hv + slack), least);
+        const F4 keep = le(across, dv * hu + du * hv + slack) & le(bound, limit4);
         const int mask = bits(keep);
         if (mask != 0) {
-          std::int32_t key[4];
-          sorted_keys(bound, keep, key);
-          // Push all kept children but the nearest, farthest first: three slots written
-          // unconditionally (junk beyond the kept ones), the top moved by kept - 1.
-          const int kept = kCount[mask];
-          for (int j = 0; j < 3; ++j) {
-            const std::int32_t k = key[(kept - 1 - j) & 3];
-            stack[top + j] = nd.child[k & 3], stack_bound[top + j] = key_bound(k);
-          }
-          top += kept - 1;
-          ref = nd.child[key[0] & 3];
+          // All four keys, farthest first, go on the stack with this node's index; the top moves
+          // up by kept - 1, so that the nearest (the last kept) becomes the current reference and
+          // the others wait in order; the slots beyond are junk.
+          sorted_keys(bound, keep, stack_key + top);
+          store4(stack_node + top, ref);
+          top += kCount[mask] - 1;
+          ref = nd.child[stack_key[top] & 3];
           continue;
         }
       } else {
         if (visit_block(blocks[~ref], l, best)) {
           limit = std::max(float_up(std::abs(best.distance) * scale * (1.0 + 1e-9)), 0x1p-125f);
+          limit4 = F4::all(limit);
         }
       }
       do {
         if (top == 0) return best;
         --top;
-      } while (stack_bound[top] > limit);
-      ref = stack[top];
+      } while (key_bound(stack_key[top]) > limit);
+      ref = line_nodes[stack_node[top]].child[stack_key[top] & 3];
     }
   }
 
