@@ -116,6 +116,17 @@ void seed_patch(C3t3& c3t3, const Domain& domain, const SurfaceMesh& surface, in
   }
 }
 
+// Delaunay refinement of the complex to the criteria (no perturbation), then optionally exudation
+// of slivers.
+void refine(C3t3& c3t3, const Domain& domain, const Criteria& criteria, bool exude) {
+  namespace params = CGAL::parameters;
+  if (exude) {
+    CGAL::refine_mesh_3(c3t3, domain, criteria, params::no_perturb(), params::exude());
+  } else {
+    CGAL::refine_mesh_3(c3t3, domain, criteria, params::no_perturb(), params::no_exude());
+  }
+}
+
 // The tetrahedra of the complex, with their neighbours and the kind of each boundary face:
 // patch_kind(patch index) -> FacePatch.
 template <class PatchKind>
@@ -204,11 +215,7 @@ ShellMesh mesh_shell(const Points3Ref& source_vertices, const FacesRef& source_f
     // (Asking for the construction object makes the domain detect its borders, as make_mesh_3 would.)
     (void)domain.construct_initial_points_object();
     for (int patch = 1; patch <= 2; ++patch) seed_patch(c3t3, domain, patches[patch - 1], patch);
-    if (criteria.exude) {
-      CGAL::refine_mesh_3(c3t3, domain, mesh_criteria, params::no_perturb(), params::exude());
-    } else {
-      CGAL::refine_mesh_3(c3t3, domain, mesh_criteria, params::no_perturb(), params::no_exude());
-    }
+    refine(c3t3, domain, mesh_criteria, criteria.exude);
   } catch (const CGAL::Failure_exception& e) {
     throw GeometryError(std::string("meshing the region between the surfaces failed: ") + e.what());
   }
@@ -360,11 +367,7 @@ ShellMesh CrossingRegion::mesh(const ShellMeshCriteria& criteria) const {
     const Criteria fine(params::edge_size = sizing, params::facet_angle = 25.0, params::facet_size = sizing,
                         params::facet_distance = criteria.facet_distance, params::cell_radius_edge_ratio = 3.0,
                         params::cell_size = sizing);
-    if (criteria.exude) {
-      CGAL::refine_mesh_3(c3t3, domain, fine, params::no_perturb(), params::exude());
-    } else {
-      CGAL::refine_mesh_3(c3t3, domain, fine, params::no_perturb(), params::no_exude());
-    }
+    refine(c3t3, domain, fine, criteria.exude);
   } catch (const CGAL::Failure_exception& e) {
     throw GeometryError(std::string("meshing the region between the surfaces failed: ") + e.what());
   }
