@@ -211,11 +211,14 @@ def test_sphere_onto_ellipsoid_minimal_distance_leaves_regions_unreached(sphere)
     v2, f2 = ellipsoid(4)
     md = mm.map_surfaces((v1, f1), (v2, f2), "minimal_distance")
     normal = mm.map_surfaces((v1, f1), (v2, f2), "normal")
+    diffusion = mm.map_surfaces((v1, f1), (v2, f2), "diffusion")
     lost_md = unreached_fraction(md.ends, v2, f2)
     lost_normal = unreached_fraction(normal.ends, v2, f2)
-    print(f"unreached area: minimal distance {lost_md:.3f}, normal {lost_normal:.4f}")
+    lost_diffusion = unreached_fraction(diffusion.ends, v2, f2)
+    print(f"unreached area: minimal distance {lost_md:.3f}, normal {lost_normal:.4f}, diffusion {lost_diffusion:.4f}")
     assert lost_md > 0.15
     assert lost_normal < 0.01
+    assert lost_diffusion < 0.01
     qn = mm.quality(normal, (v1, f1), (v2, f2))
     qmd = mm.quality(md, (v1, f1), (v2, f2))
     assert isinstance(qn, mm.SurfaceQuality)
