@@ -466,68 +466,90 @@ struct CurveIndex::Impl {
     return best;
   }
 
-  // Nearest hit of a whole line: the float tree culls boxes the line misses and boxes whose
-  // nearest |t| exceeds the best hit so far, and orders the rest nearest first; the leaves test
-  // the segments in double.
-  Hit line(const Line& l) const {
+  // One line's walk through the float tree, advanced a node or leaf at a time (`step`), so that a
+  // thread can interleave a few lines: one walk is a chain of dependent loads and compares, and
+  // the core overlaps independent chains.
+  struct LineWalk {
+    Line l;
     Hit best;
+    F4 ux, uy, nx, ny, fd, fe, fslack, limit4;
+    float limit;
+    std::int32_t ref;
+    int top;
+    // Waiting children: their key (bound and lane, see sorted_keys) and their parent's index.
+    std::int32_t stack_key[kStackSize], stack_node[kStackSize];
+  };
+
+  // Starts the walk of a line; false when it misses the curve's box outright (no hit).
+  bool start(LineWalk& w, const Line& l) const {
+    w.l = l, w.best = Hit{};
     // The line in the normalised frame: n . x' = d with n = (-uy, ux); t' = u . x' - e.
     const double px = (l.ox - centre_x) * scale, py = (l.oy - centre_y) * scale;
     double d = l.ux * py - l.uy * px, e = l.ux * px + l.uy * py;
     float line_slack = std::numeric_limits<float>::infinity();
     if (std::isfinite(d) && std::isfinite(e)) {
       // The curve lies within sqrt(2) of the frame's origin (d is exact to ~1e-16 (|d| + |e|)).
-      if (std::abs(d) > 4.0 + 1e-6 * (std::abs(d) + std::abs(e))) return best;
+      if (std::abs(d) > 4.0 + 1e-6 * (std::abs(d) + std::abs(e))) return false;
       if (std::abs(e) <= 1e30) line_slack = float_up(kFloatSlack * (std::abs(d) + std::abs(e)));
     }
     if (line_slack == std::numeric_limits<float>::infinity()) d = e = 0.0;  // astronomically far: no culling
-    const F4 ux = F4::all(static_cast<float>(l.ux)), uy = F4::all(static_cast<float>(l.uy));
-    const F4 nx = F4::all(static_cast<float>(-l.uy)), ny = ux;
-    const F4 fd = F4::all(static_cast<float>(d)), fe = F4::all(static_cast<float>(e));
-    const F4 fslack = F4::all(line_slack), least = F4::all(std::numeric_limits<float>::min());
+    w.ux = F4::all(static_cast<float>(l.ux)), w.uy = F4::all(static_cast<float>(l.uy));
+    w.nx = F4::all(static_cast<float>(-l.uy)), w.ny = w.ux;
+    w.fd = F4::all(static_cast<float>(d)), w.fe = F4::all(static_cast<float>(e));
+    w.fslack = F4::all(line_slack);
     // Bounds (at least FLT_MIN, see sorted_keys) are compared with the best |t|' rounded up and
     // at least 2^-125, above any key of a bound FLT_MIN.
-    float limit = std::numeric_limits<float>::infinity();
-    F4 limit4 = F4::all(limit);
+    w.limit = std::numeric_limits<float>::infinity();
+    w.limit4 = F4::all(w.limit);
+    w.ref = 0, w.top = 0;
+    return true;
+  }
+
+  // One node or leaf of the walk: the float tree culls boxes the line misses and boxes whose
+  // nearest |t| exceeds the best hit so far, and orders the rest nearest first; the leaves test
+  // the segments in double. False when the walk is over (w.best is the answer).
+  bool step(LineWalk& w) const {
     static constexpr int kCount[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
-    // Waiting children: their key (bound and lane, see sorted_keys) and their parent's index.
-    std::int32_t stack_key[kStackSize], stack_node[kStackSize];
-    int top = 0;
-    std::int32_t ref = 0;
-    for (;;) {
-      if (ref >= 0) {
-        const LineNode& nd = line_nodes[ref];
-        const F4 cx = F4::load(nd.cx), cy = F4::load(nd.cy), ax = F4::load(nd.ax), ay = F4::load(nd.ay);
-        const F4 hu = F4::load(nd.hu), hv = F4::load(nd.hv), slack = F4::load(nd.slack) + fslack;
-        // The line's direction in each box's frame (du along the axis, dv across), the box's
-        // half widths across the line and along it, and its centre's offsets.
-        const F4 du = abs(ux * ax + uy * ay), dv = abs(ux * ay - uy * ax);
-        const F4 across = abs(nx * cx + ny * cy - fd), along = abs(ux * cx + uy * cy - fe);
-        const F4 bound = max(along - (du * hu + dv * hv + slack), least);
-        const F4 keep = le(across, dv * hu + du * hv + slack) & le(bound, limit4);
-        const int mask = bits(keep);
-        if (mask != 0) {
-          // All four keys, farthest first, go on the stack with this node's index; the top moves
-          // up by kept - 1, so that the nearest (the last kept) becomes the current reference and
-          // the others wait in order; the slots beyond are junk.
-          sorted_keys(bound, keep, stack_key + top);
-          store4(stack_node + top, ref);
-          top += kCount[mask] - 1;
-          ref = nd.child[stack_key[top] & 3];
-          continue;
-        }
-      } else {
-        if (visit_block(blocks[~ref], l, best)) {
-          limit = std::max(float_up(std::abs(best.distance) * scale * (1.0 + 1e-9)), 0x1p-125f);
-          limit4 = F4::all(limit);
-        }
+    if (w.ref >= 0) {
+      const LineNode& nd = line_nodes[w.ref];
+      const F4 cx = F4::load(nd.cx), cy = F4::load(nd.cy), ax = F4::load(nd.ax), ay = F4::load(nd.ay);
+      const F4 hu = F4::load(nd.hu), hv = F4::load(nd.hv), slack = F4::load(nd.slack) + w.fslack;
+      // The line's direction in each box's frame (du along the axis, dv across), the box's
+      // half widths across the line and along it, and its centre's offsets.
+      const F4 du = abs(w.ux * ax + w.uy * ay), dv = abs(w.ux * ay - w.uy * ax);
+      const F4 across = abs(w.nx * cx + w.ny * cy - w.fd), along = abs(w.ux * cx + w.uy * cy - w.fe);
+      const F4 bound = max(along - (du * hu + dv * hv + slack), F4::all(std::numeric_limits<float>::min()));
+      const F4 keep = le(across, dv * hu + du * hv + slack) & le(bound, w.limit4);
+      const int mask = bits(keep);
+      if (mask != 0) {
+        // All four keys, farthest first, go on the stack with this node's index; the top moves
+        // up by kept - 1, so that the nearest (the last kept) becomes the current reference and
+        // the others wait in order; the slots beyond are junk.
+        sorted_keys(bound, keep, w.stack_key + w.top);
+        store4(w.stack_node + w.top, w.ref);
+        w.top += kCount[mask] - 1;
+        w.ref = nd.child[w.stack_key[w.top] & 3];
+        return true;
       }
-      do {
-        if (top == 0) return best;
-        --top;
-      } while (key_bound(stack_key[top]) > limit);
-      ref = line_nodes[stack_node[top]].child[stack_key[top] & 3];
+    } else if (visit_block(blocks[~w.ref], w.l, w.best)) {
+      w.limit = std::max(float_up(std::abs(w.best.distance) * scale * (1.0 + 1e-9)), 0x1p-125f);
+      w.limit4 = F4::all(w.limit);
     }
+    do {
+      if (w.top == 0) return false;
+      --w.top;
+    } while (key_bound(w.stack_key[w.top]) > w.limit);
+    w.ref = line_nodes[w.stack_node[w.top]].child[w.stack_key[w.top] & 3];
+    return true;
+  }
+
+  Hit line(const Line& l) const {
+    LineWalk w;
+    if (start(w, l)) {
+      while (step(w)) {
+      }
+    }
+    return w.best;
   }
 
   // The four segments of a leaf: the crossing test of `visit` (the same operations, so the
@@ -654,13 +676,38 @@ CurveHits CurveIndex::line_intersections(const Points2Ref& origins,
     }
   }
   CurveHits hits = allocate_hits(origins.rows());
+  const Impl& impl = *impl_;
   tbb::parallel_for(tbb::blocked_range<Index>(0, origins.rows(), kGrain),
                     [&](const tbb::blocked_range<Index>& range) {
-                      for (Index i = range.begin(); i < range.end(); ++i) {
-                        const double dx = directions(i, 0), dy = directions(i, 1);
-                        const double norm = std::sqrt(dx * dx + dy * dy);
-                        const double ux = dx / norm, uy = dy / norm;
-                        store(hits, i, impl_->line({origins(i, 0), origins(i, 1), ux, uy}));
+                      // kWalks lines at a time, each slot refilled with the next line as its
+                      // walk ends.
+                      constexpr int kWalks = 4;
+                      Impl::LineWalk walk[kWalks];
+                      Index which[kWalks];
+                      bool live[kWalks];
+                      Index next = range.begin();
+                      auto refill = [&](int k) {
+                        while (next < range.end()) {
+                          const Index i = next++;
+                          const double dx = directions(i, 0), dy = directions(i, 1);
+                          const double norm = std::sqrt(dx * dx + dy * dy);
+                          if (impl.start(walk[k], {origins(i, 0), origins(i, 1), dx / norm, dy / norm})) {
+                            which[k] = i;
+                            return true;
+                          }
+                          store(hits, i, walk[k].best);
+                        }
+                        return false;
+                      };
+                      int running = 0;
+                      for (int k = 0; k < kWalks; ++k) running += live[k] = refill(k);
+                      while (running > 0) {
+                        for (int k = 0; k < kWalks; ++k) {
+                          if (live[k] && !impl.step(walk[k])) {
+                            store(hits, which[k], walk[k].best);
+                            running -= !(live[k] = refill(k));
+                          }
+                        }
                       }
                     });
   return hits;
