@@ -14,6 +14,7 @@
 #endif
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <cmath>
 #include <cstdint>
@@ -72,13 +73,17 @@ struct alignas(64) LineNode {
 };
 static_assert(sizeof(LineNode) == 128, "two cache lines");
 
-// A leaf's segments side by side (padded to kLeafSize with copies of its last one, which can only
-// tie with it), so that the crossing tests run two at a time.
-struct alignas(16) LeafBlock {
-  double ax[kLeafSize], ay[kLeafSize], ex[kLeafSize], ey[kLeafSize];
-  std::int32_t segment[kLeafSize];  // index in `segments`
+// Four segments of a line leaf side by side, their end points in the normalised frame in float
+// (a line leaf holds up to kLineLeaf segments in consecutive groups, the last padded with copies
+// of its last segment, which can only tie with it). `slack` bounds the rounding of the float
+// sides of the line at the end points, like LineNode::slack. A line leaf's reference is
+// ~(first group * 8 + groups - 1).
+struct alignas(16) Group {
+  float ax[4], ay[4], bx[4], by[4], slack[4];
+  std::int32_t segment[4];  // index in `segments`
 };
-static_assert(kLeafSize == 4, "the leaf test runs two pairs");
+constexpr int kLineLeaf = 16;  // segments; a leaf below a node of four leaves of four, one level less
+static_assert(kLineLeaf % 4 == 0 && kLineLeaf / 4 <= 8, "a line leaf's group count takes 3 bits");
 
 // Relative bound on the rounding of the float box test: its terms have a few float roundings
 // (2^-24) each and the inputs one more; 4e-6 is ~60 ulps, far above the error, far below a box.
@@ -100,6 +105,7 @@ struct F4 {
   friend F4 operator-(F4 a, F4 b) { return {_mm_sub_ps(a.v, b.v)}; }
   friend F4 operator*(F4 a, F4 b) { return {_mm_mul_ps(a.v, b.v)}; }
   friend F4 operator&(F4 a, F4 b) { return {_mm_and_ps(a.v, b.v)}; }
+  friend F4 operator|(F4 a, F4 b) { return {_mm_or_ps(a.v, b.v)}; }
   friend F4 abs(F4 a) { return {_mm_andnot_ps(_mm_set1_ps(-0.0f), a.v)}; }
   friend F4 max(F4 a, F4 b) { return {_mm_max_ps(a.v, b.v)}; }
   friend F4 le(F4 a, F4 b) { return {_mm_cmple_ps(a.v, b.v)}; }  // false for NaN
@@ -142,6 +148,7 @@ struct F4 {
   friend F4 operator-(F4 a, F4 b) { return map(a, b, [](float x, float y) { return x - y; }); }
   friend F4 operator*(F4 a, F4 b) { return map(a, b, [](float x, float y) { return x * y; }); }
   friend F4 operator&(F4 a, F4 b) { return map(a, b, [](float x, float y) { return x != 0 && y != 0 ? 1.0f : 0.0f; }); }
+  friend F4 operator|(F4 a, F4 b) { return map(a, b, [](float x, float y) { return x != 0 || y != 0 ? 1.0f : 0.0f; }); }
   friend F4 abs(F4 a) { return {{std::abs(a.v[0]), std::abs(a.v[1]), std::abs(a.v[2]), std::abs(a.v[3])}}; }
   friend F4 max(F4 a, F4 b) { return map(a, b, [](float x, float y) { return x > y ? x : y; }); }
   friend F4 le(F4 a, F4 b) { return map(a, b, [](float x, float y) { return x <= y ? 1.0f : 0.0f; }); }
@@ -160,6 +167,16 @@ void sorted_keys(F4 bound, F4 keep, std::int32_t* out) {
 
 void store4(std::int32_t* out, std::int32_t x) { std::fill(out, out + 4, x); }
 #endif
+
+int count_trailing_zeros(unsigned x) {  // x != 0
+#if defined(__GNUC__) || defined(__clang__)
+  return __builtin_ctz(x);
+#else
+  int n = 0;
+  while (!(x >> n & 1u)) ++n;
+  return n;
+#endif
+}
 
 float key_bound(std::int32_t key) {
   float b;
@@ -201,10 +218,13 @@ struct CurveIndex::Impl {
   bool closed = true;
   std::vector<Segment> segments;
   std::vector<Node> nodes;
-  // Line queries: the same tree in float (LineNode), the leaves as blocks, and the normalised
-  // frame x' = (x - centre) * scale with the curve in [-1, 1]^2.
+  // Segment ranges of the children of `nodes` (lo, hi for each), for the line tree.
+  std::vector<std::array<std::int32_t, 2 * kWidth>> ranges;
+  // Line queries: the same tree in float (LineNode) down to ranges of at most kLineLeaf segments,
+  // which become leaves of groups, and the normalised frame x' = (x - centre) * scale with the
+  // curve in [-1, 1]^2.
   std::vector<LineNode> line_nodes;
-  std::vector<LeafBlock> blocks;
+  std::vector<Group> groups;
   double centre_x = 0.0, centre_y = 0.0, scale = 1.0;
 
   Impl(const Points2Ref& curve, bool is_closed) : closed(is_closed) {
@@ -240,9 +260,11 @@ struct CurveIndex::Impl {
       scale = std::ldexp(1.0, std::min(-exponent, 1000));
     }
     nodes.reserve(count / kLeafSize + 1);
-    line_nodes.reserve(count / kLeafSize + 1);
-    blocks.reserve(count / 2 + 1);
+    ranges.reserve(count / kLeafSize + 1);
     build(0, static_cast<std::int32_t>(count));
+    line_nodes.reserve(count / kLineLeaf + 1);
+    groups.reserve(count / 2 + 1);
+    build_lines(0);
   }
 
   // Median split on the longer axis of the centroid box; segments are reordered in place.
@@ -338,22 +360,53 @@ struct CurveIndex::Impl {
     nd.slack[k] = float_up(kFloatSlack * (std::abs(fcx) + std::abs(fcy) + nd.hu[k] + nd.hv[k]) + 1e-30);
   }
 
-  // The leaf block of segments [begin, end), padded with copies of the last one.
-  std::int32_t make_block(std::int32_t begin, std::int32_t end) {
-    LeafBlock b;
-    for (int k = 0; k < kLeafSize; ++k) {
-      const std::int32_t i = std::min(begin + k, end - 1);
-      const Segment& s = segments[i];
-      b.ax[k] = s.ax, b.ay[k] = s.ay, b.ex[k] = s.ex, b.ey[k] = s.ey, b.segment[k] = i;
+  // The line leaf of segments [begin, end): groups of four, padded with copies of the last one.
+  std::int32_t make_leaf(std::int32_t begin, std::int32_t end) {
+    const auto first = static_cast<std::int32_t>(groups.size());
+    for (std::int32_t g = begin; g < end; g += 4) {
+      Group group;
+      for (int k = 0; k < 4; ++k) {
+        const std::int32_t i = std::min(g + k, end - 1);
+        const Segment& s = segments[i];
+        const double ax = (s.ax - centre_x) * scale, ay = (s.ay - centre_y) * scale;
+        group.ax[k] = static_cast<float>(ax), group.ay[k] = static_cast<float>(ay);
+        group.bx[k] = static_cast<float>(ax + s.ex * scale), group.by[k] = static_cast<float>(ay + s.ey * scale);
+        group.slack[k] = float_up(kFloatSlack * std::max(std::abs(group.ax[k]) + std::abs(group.ay[k]),
+                                                         std::abs(group.bx[k]) + std::abs(group.by[k])) + 1e-30);
+        group.segment[k] = i;
+      }
+      groups.push_back(group);
     }
-    blocks.push_back(b);
-    return static_cast<std::int32_t>(blocks.size() - 1);
+    const auto count = static_cast<std::int32_t>(groups.size()) - first;
+    return ~(first * 8 + count - 1);
+  }
+
+  // The line node for node `index` of the double tree: the same children, but a child of at most
+  // kLineLeaf segments is a line leaf.
+  std::int32_t build_lines(std::int64_t index) {
+    const auto line_index = static_cast<std::int32_t>(line_nodes.size());
+    line_nodes.push_back({});
+    for (int k = 0; k < kWidth; ++k) {
+      const Node& nd = nodes[index];
+      const std::int32_t lo = ranges[index][2 * k], hi = ranges[index][2 * k + 1];
+      LineNode& ln = line_nodes[line_index];
+      if (nd.child[k] == kUnused) {
+        ln.cx[k] = ln.cy[k] = ln.ay[k] = ln.slack[k] = 0.0f, ln.ax[k] = 1.0f, ln.child[k] = 0;
+        ln.hu[k] = ln.hv[k] = std::numeric_limits<float>::quiet_NaN();
+        continue;
+      }
+      fit_line_box(lo, hi, nd.ux[k], nd.uy[k], ln, k);
+      // A range of more than kLineLeaf segments is an inner node (kLineLeaf >= kLeafSize).
+      const std::int32_t child = hi - lo <= kLineLeaf ? make_leaf(lo, hi) : build_lines(nd.child[k]);
+      line_nodes[line_index].child[k] = child;  // build_lines may move `line_nodes`
+    }
+    return line_index;
   }
 
   std::int64_t build(std::int32_t begin, std::int32_t end) {
     const auto index = static_cast<std::int64_t>(nodes.size());
     nodes.push_back({});
-    line_nodes.push_back({});
+    ranges.push_back({});
     std::int32_t lo[kWidth] = {begin}, hi[kWidth] = {end};
     int parts = 1;
     while (parts < kWidth) {
@@ -368,22 +421,17 @@ struct CurveIndex::Impl {
     }
     for (int k = 0; k < kWidth; ++k) {
       Node& nd = nodes[index];
-      LineNode& ln = line_nodes[index];
       if (k >= parts) {
         nd.cx[k] = nd.cy[k] = nd.uy[k] = nd.hu[k] = nd.hv[k] = 0.0, nd.ux[k] = 1.0, nd.child[k] = kUnused;
-        ln.cx[k] = ln.cy[k] = ln.ay[k] = ln.slack[k] = 0.0f, ln.ax[k] = 1.0f, ln.child[k] = 0;
-        ln.hu[k] = ln.hv[k] = std::numeric_limits<float>::quiet_NaN();
         continue;
       }
+      ranges[index][2 * k] = lo[k], ranges[index][2 * k + 1] = hi[k];
       fit_box(lo[k], hi[k], nd, k);
-      fit_line_box(lo[k], hi[k], nd.ux[k], nd.uy[k], ln, k);
       if (hi[k] - lo[k] <= kLeafSize) {
         nd.child[k] = leaf_ref(lo[k], hi[k] - lo[k]);
-        ln.child[k] = ~make_block(lo[k], hi[k]);
       } else {
-        const std::int64_t child = build(lo[k], hi[k]);  // may move `nodes` and `line_nodes`
+        const std::int64_t child = build(lo[k], hi[k]);  // may move `nodes`
         nodes[index].child[k] = child;
-        line_nodes[index].child[k] = static_cast<std::int32_t>(child);
       }
     }
     return index;
@@ -531,7 +579,7 @@ struct CurveIndex::Impl {
         w.ref = nd.child[w.stack_key[w.top] & 3];
         return true;
       }
-    } else if (visit_block(blocks[~w.ref], w.l, w.best)) {
+    } else if (visit_leaf(~w.ref, w)) {
       w.limit = std::max(float_up(std::abs(w.best.distance) * scale * (1.0 + 1e-9)), 0x1p-125f);
       w.limit4 = F4::all(w.limit);
     }
@@ -552,36 +600,30 @@ struct CurveIndex::Impl {
     return w.best;
   }
 
-  // The four segments of a leaf: the crossing test of `visit` (the same operations, so the
-  // same decisions) two at a time; only candidates, and segments parallel to the line, go on to
-  // `visit`. True when the best hit changed.
-  bool visit_block(const LeafBlock& b, const Line& l, Hit& best) const {
-    const Segment* before = best.segment;
-#ifdef MORPHOMAP_SSE2
-    const __m128d ox = _mm_set1_pd(l.ox), oy = _mm_set1_pd(l.oy), ux = _mm_set1_pd(l.ux), uy = _mm_set1_pd(l.uy);
-    const __m128d sign = _mm_set1_pd(-0.0), tiny = _mm_set1_pd(1e-12);
-    int candidates = 0;
-    for (int p = 0; p < kLeafSize; p += 2) {
-      const __m128d wx = _mm_sub_pd(_mm_load_pd(b.ax + p), ox), wy = _mm_sub_pd(_mm_load_pd(b.ay + p), oy);
-      const __m128d ex = _mm_load_pd(b.ex + p), ey = _mm_load_pd(b.ey + p);
-      const __m128d denom = _mm_sub_pd(_mm_mul_pd(ux, ey), _mm_mul_pd(uy, ex));
-      const __m128d along = _mm_sub_pd(_mm_mul_pd(wx, uy), _mm_mul_pd(wy, ux));
-      // along and denom with denom's sign made positive: a segment is rejected where `visit`
-      // rejects it, along < -slack or along > |denom| + slack (a NaN is not rejected).
-      const __m128d flip = _mm_and_pd(denom, sign);
-      const __m128d a = _mm_xor_pd(along, flip), size = _mm_andnot_pd(sign, denom);
-      const __m128d slack = _mm_mul_pd(tiny, size);
-      const __m128d kept = _mm_and_pd(_mm_cmpnlt_pd(a, _mm_xor_pd(slack, sign)),
-                                      _mm_cmpngt_pd(a, _mm_add_pd(size, slack)));
-      candidates |= _mm_movemask_pd(_mm_or_pd(kept, _mm_cmpeq_pd(denom, _mm_setzero_pd()))) << p;
+  // A line leaf: the segments whose end points are not strictly on one side of the line (in
+  // float, with slack, so that no segment the line meets is missed) go on to `visit`. True when
+  // the best hit changed.
+  bool visit_leaf(std::int32_t code, LineWalk& w) const {
+    const Segment* before = w.best.segment;
+    const Group* group = &groups[code >> 3];
+    const int count = (code & 7) + 1;
+    unsigned candidates = 0;
+    for (int g = 0; g < count; ++g) {
+      const Group& gr = group[g];
+      const F4 sa = w.nx * F4::load(gr.ax) + w.ny * F4::load(gr.ay) - w.fd;
+      const F4 sb = w.nx * F4::load(gr.bx) + w.ny * F4::load(gr.by) - w.fd;
+      const F4 slack = F4::load(gr.slack) + w.fslack;
+      // min(sa, sb) <= slack and max(sa, sb) >= -slack
+      const F4 zero = F4::all(0.0f);
+      const F4 near_side = le(sa, slack) | le(sb, slack), far_side = le(zero - sa, slack) | le(zero - sb, slack);
+      candidates |= static_cast<unsigned>(bits(near_side & far_side)) << (4 * g);
     }
-    for (int k = 0; k < kLeafSize; ++k) {
-      if (candidates >> k & 1) visit(segments[b.segment[k]], l, best);
+    while (candidates != 0) {
+      const int k = count_trailing_zeros(candidates);
+      candidates &= candidates - 1;
+      visit(segments[group[k >> 2].segment[k & 3]], w.l, w.best);
     }
-#else
-    for (int k = 0; k < kLeafSize; ++k) visit(segments[b.segment[k]], l, best);
-#endif
-    return best.segment != before;
+    return w.best.segment != before;
   }
 
   // Intersection of the line with one segment; keeps it when it beats the best so far. The
