@@ -1,6 +1,7 @@
 // Closest points and line intersections against one polyline, through a bounding-volume hierarchy
 // of its segments. CGAL 5.5's AABB tree is 3D only, and a 2D hierarchy in double precision with
-// ordered traversal is small; bench/ measures it against the peers.
+// ordered traversal is small; bench/ measures it against the peers. Line queries walk a float32
+// copy of its upper levels (conservative bounds: the hits themselves are computed in double).
 #include <morphomap/curve_queries.hpp>
 
 #include "validation.hpp"
@@ -60,13 +61,13 @@ static_assert(kLeafSize < 8, "a leaf reference keeps its count in 3 bits");
 
 std::int64_t leaf_ref(std::int32_t first, std::int32_t count) { return ~(std::int64_t{first} * 8 + count); }
 
-// The same tree for line queries, with the boxes in float32 and in a normalised frame (the curve's
-// bounding box centred on 0 and scaled by a power of 2 into [-1, 1]^2), so that a node's four
-// boxes are tested in one SSE register. Each float box contains its segments exactly (its
+// The upper levels of the same tree for line queries, with the boxes in float32 and in a
+// normalised frame (the curve's bounding box centred on 0 and scaled by a power of 2 into
+// [-1, 1]^2), so that a node's four boxes are tested in one SSE register. Each float box contains its segments exactly (its
 // extents are fitted around the float centre and axis and rounded outward); `slack` is an upper
 // bound, scaled from the box's magnitudes, on the rounding of the float test, so the test never
 // culls a box that a line meets. Unused slots have NaN extents, which no comparison passes.
-// child: an inner node's index, or ~(block index) for a leaf.
+// child: an inner line node's index, or a line leaf's code (see Group).
 struct alignas(64) LineNode {
   float cx[kWidth], cy[kWidth], ax[kWidth], ay[kWidth], hu[kWidth], hv[kWidth], slack[kWidth];
   std::int32_t child[kWidth];
@@ -265,6 +266,7 @@ struct CurveIndex::Impl {
     line_nodes.reserve(count / kLineLeaf + 1);
     groups.reserve(count / 2 + 1);
     build_lines(0);
+    ranges = {};  // only needed to build
   }
 
   // Median split on the longer axis of the centroid box; segments are reordered in place.
@@ -589,15 +591,6 @@ struct CurveIndex::Impl {
     } while (key_bound(w.stack_key[w.top]) > w.limit);
     w.ref = line_nodes[w.stack_node[w.top]].child[w.stack_key[w.top] & 3];
     return true;
-  }
-
-  Hit line(const Line& l) const {
-    LineWalk w;
-    if (start(w, l)) {
-      while (step(w)) {
-      }
-    }
-    return w.best;
   }
 
   // A line leaf: the segments whose end points are not strictly on one side of the line (in
