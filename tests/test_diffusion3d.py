@@ -43,6 +43,8 @@ def test_concentric_spheres_radial(spheres):
     # The ends lie on the target (a polyhedron inscribed in the sphere of radius 4).
     radii = np.linalg.norm(solution.ends, axis=1)
     assert (radii <= 4.0 + 1e-9).all() and (radii > 3.98).all()
+    field = mm.DisplacementField(inner[0], solution.ends, np.full(len(inner[0]), "diffusion"), faces=inner[1])
+    assert mm.quality(field, inner, spheres[1]).folds == 0
 
 
 def test_concentric_spheres_potential(spheres):
