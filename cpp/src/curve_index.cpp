@@ -63,10 +63,11 @@ std::int64_t leaf_ref(std::int32_t first, std::int32_t count) { return ~(std::in
 
 // The upper levels of the same tree for line queries, with the boxes in float32 and in a
 // normalised frame (the curve's bounding box centred on 0 and scaled by a power of 2 into
-// [-1, 1]^2), so that a node's four boxes are tested in one SSE register. Each float box contains its segments exactly (its
-// extents are fitted around the float centre and axis and rounded outward); `slack` is an upper
-// bound, scaled from the box's magnitudes, on the rounding of the float test, so the test never
-// culls a box that a line meets. Unused slots have NaN extents, which no comparison passes.
+// [-1, 1]^2), so that a node's four boxes are tested in one SSE register. Each float box contains
+// its segments exactly (its extents are fitted around the float centre and axis and rounded
+// outward); `slack` is an upper bound, scaled from the box's magnitudes, on the rounding of the
+// float test, so the test never culls a box that a line meets. Unused slots have NaN extents,
+// which no comparison passes.
 // child: an inner line node's index, or a line leaf's code (see Group).
 struct alignas(64) LineNode {
   float cx[kWidth], cy[kWidth], ax[kWidth], ay[kWidth], hu[kWidth], hv[kWidth], slack[kWidth];
@@ -325,8 +326,6 @@ struct CurveIndex::Impl {
     nd.hu[k] = hu + pad, nd.hv[k] = hv + pad;
   }
 
-  // A node over [begin, end): the range is split (largest part first) into up to four parts;
-  // parts of at most kLeafSize segments become leaves, the others nodes of their own.
   // The float box of segments [begin, end) as child k of line node `nd`, in the normalised frame
   // and along the double box's axis (or x where that overflowed): the axis is rounded to float,
   // then the centre fitted and rounded, then the extents fitted around exactly those and rounded
@@ -405,6 +404,8 @@ struct CurveIndex::Impl {
     return line_index;
   }
 
+  // A node over [begin, end): the range is split (largest part first) into up to four parts;
+  // parts of at most kLeafSize segments become leaves, the others nodes of their own.
   std::int64_t build(std::int32_t begin, std::int32_t end) {
     const auto index = static_cast<std::int64_t>(nodes.size());
     nodes.push_back({});

@@ -220,7 +220,9 @@ ShellMesh mesh_shell(const Points3Ref& source_vertices, const FacesRef& source_f
     throw GeometryError(std::string("meshing the region between the surfaces failed: ") + e.what());
   }
 
-  return to_shell_mesh(c3t3, [](int patch) { return patch == 1 ? source_face : patch == 2 ? target_face : other_face; });
+  return to_shell_mesh(c3t3, [](int patch) {
+    return patch == 1 ? source_face : patch == 2 ? target_face : other_face;
+  });
 }
 
 // Each patch: a connected piece of one surface between the curves where the surfaces cross,

@@ -37,10 +37,11 @@ struct ShellDiffusionSolution {
 // shell between them when one lies inside the other (which one is found); when they cross, the
 // pieces of their symmetric difference (S1 outside S2, S2 outside S1), each bounded by parts of
 // both, meshed together with the crossing curves as mesh edges (c = 0 on them). Surfaces that lie
-// apart, intersect themselves or coincide over a patch: InvalidInput. Streamlines start on the mesh boundary at the closest point to each
-// source vertex and follow the recovered, linearly interpolated -grad c in RK4 steps; where one
-// leaves the mesh through the target boundary, its end is moved to the closest point of the
-// target surface.
+// apart, intersect themselves or coincide over a patch: InvalidInput. Streamlines start on the
+// mesh boundary at the closest point to each source vertex and follow the recovered, linearly
+// interpolated -grad c in RK4 steps (in the tetrahedra at a crossing curve, where c jumps, each
+// one's own P1 gradient); where one leaves the mesh through the target boundary, its end is moved
+// to the closest point of the target surface, and one that runs into a crossing curve ends there.
 ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, const FacesRef& source_faces,
                                           const Points3Ref& target_vertices, const FacesRef& target_faces,
                                           const ShellDiffusionOptions& options = {});
