@@ -24,7 +24,9 @@ struct RegionMesh {
 // lattice of spacing just under max_edge is seeded inside, a spacing away from the loops. Then
 // refinement: Ruppert's angle criterion (smallest angle about 20.7 degrees), which grades the mesh
 // from the point spacing on the loops and refines narrow gaps, and edges no longer than max_edge
-// (no bound when max_edge <= 0).
+// (no bound when max_edge <= 0), except in triangles with two lattice vertices and no vertex of
+// the loops or of the graded layers: up to a lattice triangle's circumdiameter (1.12 max_edge), so
+// that a point the mesher puts among lattice points does not set off splits along a lattice row.
 RegionMesh mesh_region(const std::vector<Points2>& loops, double max_edge);
 
 }  // namespace morphomap::detail
