@@ -9,7 +9,9 @@ namespace morphomap {
 using Triangles = Eigen::Matrix<Index, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
 struct DiffusionOptions {
-  // Longest edge of the region mesh; 0 picks mesh_fraction * the mean gap between the curves
+  // Mesh size: the lattice spacing is 0.97 times it, and no edge along the curves is longer; in
+  // the lattice, a triangle next to a point the mesher added may reach the lattice triangles'
+  // circumdiameter (1.12 times it). 0 picks mesh_fraction * the mean gap between the curves
   // (twice the region's area over its boundary length). Near the curves the mesh is graded from
   // their point spacing and refined where the gap is narrow, whatever this bound.
   double mesh_size = 0.0;
