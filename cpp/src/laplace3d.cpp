@@ -92,11 +92,20 @@ class Tracer {
     std::vector<double> weight(n, 0.0);
     std::vector<Vec3> normal(n, Vec3::Zero());
     step_.resize(tets);
+    // Where the surfaces cross, c jumps from 1 to 0 along a curve and no smooth fit holds: in the
+    // tetrahedra at such a curve the flow is the element's own -grad c (the P1 field), which
+    // points away from the source faces and out through the target faces. NaN elsewhere.
+    element_flow_.assign(tets, Vec3::Constant(kNaN));
     Eigen::Matrix<double, 4, 3> g;
     for (Index t = 0; t < tets; ++t) {
       const double volume = std::abs(gradients(mesh.vertices, mesh.tetrahedra, t, g));
       Vec3 flow = Vec3::Zero();
-      for (int i = 0; i < 4; ++i) flow -= c[mesh.tetrahedra(t, i)] * g.row(i).transpose();
+      bool at_crossing = false;
+      for (int i = 0; i < 4; ++i) {
+        flow -= c[mesh.tetrahedra(t, i)] * g.row(i).transpose();
+        at_crossing = at_crossing || kind[mesh.tetrahedra(t, i)] == crossing_vertex;
+      }
+      if (at_crossing) element_flow_[t] = flow;
       double edges = 0.0;
       for (int i = 0; i < 4; ++i) {
         const Index v = mesh.tetrahedra(t, i);
@@ -119,19 +128,6 @@ class Tracer {
       if (weight[v] > 0.0) velocity_[v] /= weight[v];
     }
     recover_by_least_squares(c);
-    // Where the surfaces cross, c jumps from 1 to 0 along a curve and no smooth fit holds: in the
-    // tetrahedra at such a curve the flow is the element's own -grad c (the P1 field), which
-    // points away from the source faces and out through the target faces.
-    element_flow_.assign(tets, Vec3::Constant(kNaN));
-    for (Index t = 0; t < tets; ++t) {
-      bool at_crossing = false;
-      for (int i = 0; i < 4; ++i) at_crossing = at_crossing || kind[mesh.tetrahedra(t, i)] == crossing_vertex;
-      if (!at_crossing) continue;
-      gradients(mesh.vertices, mesh.tetrahedra, t, g);
-      Vec3 flow = Vec3::Zero();
-      for (int i = 0; i < 4; ++i) flow -= c[mesh.tetrahedra(t, i)] * g.row(i).transpose();
-      element_flow_[t] = flow;
-    }
     for (Index v = 0; v < n; ++v) {
       // On the surfaces c is constant, so the flow is normal to them: into the region at the
       // source (c = 1 is its maximum), out of it at the target. The fit only gives the speed (its
@@ -352,9 +348,8 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
   // the surfaces). Measured between spheres of radii 1 and 4: the end-point error falls about
   // linearly with the element size in the bulk, and removing slivers (exude) buys more accuracy
   // than it costs time.
-  const double gap = crossing ? crossing->volume() / (0.5 * crossing->area())
-                              : std::abs(std::abs(target.volume) - std::abs(source.volume)) /
-                                    (0.5 * (source.area + target.area));
+  const double volume = crossing ? crossing->volume() : std::abs(std::abs(target.volume) - std::abs(source.volume));
+  const double gap = volume / (0.5 * (source.area + target.area));
   detail::ShellMeshCriteria criteria;
   criteria.cell_size = options.mesh_size > 0.0 ? options.mesh_size : 0.25 * gap;
   criteria.source_size = std::min(source.mean_edge, criteria.cell_size);

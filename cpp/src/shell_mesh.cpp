@@ -235,7 +235,6 @@ struct CrossingRegion::Patches {
   std::vector<char> has_border;      // it ends at a crossing curve (a patch without one is a
                                      // whole component of a surface that the other does not cut)
   double volume = 0.0;
-  double area = 0.0;
 };
 
 namespace {
@@ -268,18 +267,16 @@ std::vector<SurfaceMesh> split_along(SurfaceMesh& mesh, const ConstrainedMap& co
   return parts;
 }
 
-// Signed volume enclosed with the origin o (positive for faces seen anticlockwise from outside),
-// and area.
-std::pair<double, double> volume_and_area(const SurfaceMesh& mesh, const Point& o) {
-  double volume = 0.0, area = 0.0;
+// Signed volume enclosed with the origin o (positive for faces seen anticlockwise from outside).
+double signed_volume(const SurfaceMesh& mesh, const Point& o) {
+  double volume = 0.0;
   for (const auto f : mesh.faces()) {
     std::array<Kernel::Vector_3, 3> p;
     int i = 0;
     for (const auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) p[i++] = mesh.point(v) - o;
     volume += CGAL::scalar_product(p[0], CGAL::cross_product(p[1], p[2])) / 6.0;
-    area += 0.5 * std::sqrt(CGAL::cross_product(p[1] - p[0], p[2] - p[0]).squared_length());
   }
-  return {volume, area};
+  return volume;
 }
 
 }  // namespace
@@ -329,16 +326,14 @@ CrossingRegion::CrossingRegion(const Points3Ref& source_vertices, const FacesRef
   // S2 \ S1 likewise: the pieces' volume is the sum over the outside patches minus the inside ones.
   const Point origin = CGAL::centroid(p.source.points().begin(), p.source.points().end());
   for (std::size_t k = 0; k < p.meshes.size(); ++k) {
-    const auto [volume, area] = volume_and_area(p.meshes[k], origin);
+    const double volume = signed_volume(p.meshes[k], origin);
     p.volume += p.inside_other[k] ? -volume : volume;
-    p.area += area;
   }
 }
 
 CrossingRegion::~CrossingRegion() = default;
 
 double CrossingRegion::volume() const { return patches_->volume; }
-double CrossingRegion::area() const { return patches_->area; }
 
 ShellMesh CrossingRegion::mesh(const ShellMeshCriteria& criteria) const {
   const Patches& p = *patches_;

@@ -55,7 +55,6 @@ class CrossingRegion {
   CrossingRegion& operator=(const CrossingRegion&) = delete;
 
   double volume() const;  // of all the pieces together
-  double area() const;    // of both surfaces together
   // Tetrahedra of every piece (subdomains 1: S1 \ S2 and 2: S2 \ S1); the curves where the
   // surfaces cross are protected as mesh edges. Throws GeometryError if Mesh_3 fails.
   ShellMesh mesh(const ShellMeshCriteria& criteria) const;
