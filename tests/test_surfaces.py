@@ -455,6 +455,28 @@ def cube():
     return v, np.array(f, np.int64)
 
 
+def test_lines_and_queries_from_beyond_float_range_of_a_tiny_surface():
+    # Origins 1e102 unit-box lengths away once made Embree's ray invalid (an assertion abort);
+    # such lines are tested in double against every face.
+    v, f = cube()
+    v = v * 1e-100
+    index = mm.SurfaceIndex(v, f)
+    origins = np.array([[800.0, 0.0, 0.0], [800.0, 0.0, 0.0], [0.0, 0.0, -5.0]])
+    directions = np.array([[-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+    hits = index.line_intersections(origins, directions)
+    # The first line meets the squares x = +-1e-100, the third z = +-1e-100 (in double, 800 - 1e-100
+    # and 800 + 1e-100 are the same distance, so either square may win the tie); the second passes
+    # 800 units beside the cube. The points o + t u round to within |o| eps of 0.
+    assert abs(v[f[hits.faces[0]], 0].sum()) == 3e-100 and abs(v[f[hits.faces[2]], 2].sum()) == 3e-100
+    assert hits.faces[1] == -1 and np.isnan(hits.points[1]).all()
+    assert hits.distances[0] == pytest.approx(800.0, rel=1e-15)
+    assert hits.distances[2] == pytest.approx(5.0, rel=1e-15)
+    # A closest-point query that far gets a clear error, not Embree's float answer (it was wrong).
+    with pytest.raises(ValueError, match="^queries: row 0 lies more than 1e30 times"):
+        index.closest_points(origins[:1])
+    np.testing.assert_array_equal(index.closest_points([[0.0, 0.0, -3e-100]]).points, [[0.0, 0.0, -1e-100]])
+
+
 def octahedron():
     v = np.array([[1.0, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]])
     f = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]]

@@ -44,6 +44,10 @@ constexpr double kInsideSlack = 1e-12;
 // The looser slack of that search, so that a line through an edge or vertex always finds a face.
 constexpr double kRingSlack = 1e-9;
 
+// Farthest a query or line origin may lie from the centre, in unit-box lengths, for Embree's
+// float scene (a ray or query beyond float range is invalid to it).
+constexpr double kReach = 1e30;
+
 struct Hit {
   V3 point{kNaN, kNaN, kNaN};
   double distance = kNaN;
@@ -248,7 +252,24 @@ struct SurfaceIndex::Impl {
         os[i] = (o[i] - centre) * scale;
         best[i] = Hit{};
       }
+      // An origin too far from the surface for float (beyond 1e30 unit-box lengths, or past the
+      // range of double) would make Embree's ray invalid: such a line is tested against every
+      // face in double instead (slow, but only for absurd input).
+      bool far[kBlock];
       for (int i = 0; i < n; ++i) {
+        far[i] = !(os[i].cwiseAbs().maxCoeff() <= kReach);
+        if (far[i]) {
+          double t = 0.0, outside = 0.0;
+          for (Index f = 0; f < faces.rows(); ++f) {
+            const bool meets =
+                detail::line_triangle(o[i], u[i], corner(f, 0), corner(f, 1), corner(f, 2), kInsideSlack, t, outside);
+            if (meets && line_hit_before(t, f, best[i])) {
+              best[i].distance = t, best[i].face = f;
+            }
+          }
+          face[i] = -1;
+          continue;
+        }
         face[i] = cast(context, os[i], u[i], std::numeric_limits<float>::infinity());
         if (face[i] >= 0) prefetch(faces.row(face[i]).data());
       }
@@ -257,6 +278,7 @@ struct SurfaceIndex::Impl {
         if (face[i] >= 0) refine(o[i], u[i], face[i], best[i]);
       }
       for (int i = 0; i < n; ++i) {
+        if (far[i]) continue;
         float tfar = std::numeric_limits<float>::infinity();
         if (best[i].face >= 0) {
           // Unit-box distance of the forward hit, widened by far more than float rounding (of
@@ -333,6 +355,9 @@ struct SurfaceIndex::Impl {
     return false;
   }
 
+  // Whether q is close enough for the float scene: within 1e30 unit-box lengths of its centre.
+  bool within_reach(const V3& q) const { return ((q - centre) * scale).cwiseAbs().maxCoeff() <= kReach; }
+
   Hit closest(const V3& q) const {
     const V3 qs = (q - centre) * scale;
     PointQuery pq{this, q, 1e-6 * (1.0 + qs.cwiseAbs().maxCoeff()), kInf, Hit{}};
@@ -368,6 +393,13 @@ SurfaceIndex& SurfaceIndex::operator=(SurfaceIndex&&) noexcept = default;
 
 SurfaceHits SurfaceIndex::closest_points(const Points3Ref& queries) const {
   detail::require_finite3(queries, "queries");
+  // Beyond that, Embree's float query is meaningless, and the double distances overflow.
+  for (Index i = 0; i < queries.rows(); ++i) {
+    if (!impl_->within_reach(queries.row(i).transpose())) {
+      detail::invalid("queries", "row " + std::to_string(i) +
+                                     " lies more than 1e30 times the surface's size from it, too far to measure");
+    }
+  }
   SurfaceHits hits = allocate_hits(queries.rows());
   tbb::parallel_for(tbb::blocked_range<Index>(0, queries.rows(), kGrain), [&](const tbb::blocked_range<Index>& range) {
     for (Index i = range.begin(); i < range.end(); ++i) store(hits, i, impl_->closest(queries.row(i).transpose()));
