@@ -13,7 +13,7 @@ def test_auto_on_the_kidney_pair_removes_the_crossings_of_normal_mapping():
     field = mm.map_curves(c1, c2)
     assert field.valid.all()
     assert mm.count_crossings(field.starts, field.ends) == 0
-    assert set(field.method) == {"normal", "diffusion"}  # normal where it works, diffusion elsewhere
+    assert set(field.method) == {"normal", "reverse_diffusion"}  # normal where it works, reverse diffusion elsewhere
     assert mm.closest_points(field.starts, c1).distances.max() < 1e-9  # starts on C1
     assert mm.closest_points(field.ends, c2).distances.max() < 1e-9  # ends on C2
 
@@ -33,7 +33,7 @@ def test_auto_falls_back_to_reverse_diffusion_for_the_whole_pair_when_they_do_no
     c2 = circle(300, 3.0)
     assert mm.count_crossings(*_vectors(mm.map_curves(c1, c2, "normal"))) > 0
     field = mm.map_curves(c1, c2, "auto")
-    assert set(field.method) == {"diffusion"}
+    assert set(field.method) == {"reverse_diffusion"}
     assert len(field) == len(c2) and field.valid.all()
     assert mm.count_crossings(field.starts, field.ends) == 0
 
@@ -46,7 +46,7 @@ def _vectors(field):
 def test_density_rule_tries_reverse_minimal_distance_on_dense_points():
     c1, c2 = circle(400, 1.0), circle(400, 2.0)  # 64 points per gap
     dense = mm.map_curves(c1, c2, density_threshold=5.0)
-    assert set(dense.method) == {"minimal_distance"} and len(dense) == len(c2)
+    assert set(dense.method) == {"reverse_minimal_distance"} and len(dense) == len(c2)
     # Radial, in order along C1 (which of the two ends of the order the vector at C1's first
     # point takes is up to rounding).
     shift = int(np.argmin(np.hypot(*(dense.ends - c2[0]).T)))

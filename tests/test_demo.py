@@ -103,7 +103,7 @@ def test_map_with_the_default_method(tmp_path):
     run = morphomap("map", tmp_path / "c1.csv", tmp_path / "c2.csv", "-o", tmp_path / "f.csv")
     assert run.returncode == 0, run.stderr
     field = mm.read_field(tmp_path / "f.csv")
-    assert set(field.method) == {"normal", "diffusion"}
+    assert set(field.method) == {"normal", "reverse_diffusion"}
     assert mm.count_crossings(field.starts, field.ends) == 0
 
 

@@ -100,7 +100,7 @@ def test_auto_gives_no_folds(pair, auto):
     assert auto.valid.all()
     # Normal mapping folds here, so "auto" takes reverse diffusion for the whole surface: the
     # vectors run from S1 to the vertices of S2, in S2's order and with S2's faces.
-    assert methods == ["diffusion"]
+    assert methods == ["reverse_diffusion"]
     assert len(auto) == len(s2.vertices)
     np.testing.assert_array_equal(auto.faces, s2.faces)
     assert distances_to(auto.starts, s1).max() < 1e-6 * diagonal(s1)
@@ -131,7 +131,7 @@ def test_long_buds_auto_turns_no_triangle_over(long_buds):
     # With longer buds the reverse-diffusion field is still orientation-preserving on the
     # surfaces: no image triangle is turned over relative to S1 or S2.
     s1, s2, field = long_buds
-    assert field.valid.all() and set(field.method) == {"diffusion"}
+    assert field.valid.all() and set(field.method) == {"reverse_diffusion"}
     assert turned_over(field, s1, s2) == 0
 
 

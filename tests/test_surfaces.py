@@ -351,7 +351,7 @@ def test_auto_falls_back_to_reverse_diffusion_where_normals_miss(sphere):
     v2 = v2 + [1.0, 0, 0]
     assert not mm.map_surfaces((v1, f1), (v2, f2), "normal").valid.all()
     field = mm.map_surfaces((v1, f1), (v2, f2), "auto")
-    assert set(field.method) == {"diffusion"}
+    assert set(field.method) == {"reverse_diffusion"}
     assert len(field) == len(v2)
     np.testing.assert_array_equal(field.faces, f2)
     valid = field.valid

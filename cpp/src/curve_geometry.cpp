@@ -8,6 +8,7 @@
 #include <CGAL/MP_Float.h>
 
 #include <cmath>
+#include <cstdio>
 
 namespace morphomap {
 namespace {
@@ -117,8 +118,11 @@ Points2 normals(const Points2Ref& points, bool closed) {
   return out;
 }
 
-bool is_self_intersecting(const Points2Ref& points, bool closed) {
-  const Points2 q = detail::without_repeats(points, closed, "points");
+namespace {
+
+// Pairs of segments (i < j, of the curve without consecutive repeats q) that meet other than
+// neighbours at their shared point: their number and, given `kept`, the pairs.
+Index self_intersecting_pairs(const Points2& q, bool closed, detail::IndexPairs* kept) {
   const Index m = q.rows();
   const Index segments = closed ? m : m - 1;
   std::vector<detail::Point> p(m);
@@ -139,7 +143,30 @@ bool is_self_intersecting(const Points2Ref& points, bool closed) {
     }
     return detail::segments_meet(p[i], p[(i + 1) % m], p[j], p[(j + 1) % m]);
   };
-  return detail::test_overlapping_pairs(boxes, hit) > 0;
+  return detail::test_overlapping_pairs(boxes, hit, kept);
 }
+
+}  // namespace
+
+bool is_self_intersecting(const Points2Ref& points, bool closed) {
+  return self_intersecting_pairs(detail::without_repeats(points, closed, "points"), closed, nullptr) > 0;
+}
+
+namespace detail {
+
+void require_no_self_intersection(const Points2Ref& points, bool closed, const char* name) {
+  const Points2 q = without_repeats(points, closed, name);
+  IndexPairs pairs;
+  const Index count = self_intersecting_pairs(q, closed, &pairs);
+  if (count == 0) return;
+  const Index i = pairs.front().first, j = pairs.front().second;
+  char where[96];
+  std::snprintf(where, sizeof where, "(%.6g, %.6g) and (%.6g, %.6g)", q(i, 0), q(i, 1), q(j, 0), q(j, 1));
+  invalid(name, "the curve intersects itself: " + std::to_string(count) + " pair" + (count == 1 ? "" : "s") +
+                    " of its segments meet, the first at the segments starting at " + where +
+                    "; the mapping needs a simple curve");
+}
+
+}  // namespace detail
 
 }  // namespace morphomap

@@ -6,6 +6,7 @@
 #include <morphomap/transform.hpp>
 
 #include "dirichlet.hpp"
+#include "interrupt_check.hpp"
 #include "region_mesh.hpp"
 #include "validation.hpp"
 
@@ -13,6 +14,7 @@
 #include <Eigen/SparseCore>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -109,6 +111,18 @@ class Tracer {
       }
     }
     for (Index v = 0; v < n; ++v) velocity_[v] /= weight[v];
+    // A vertex all of whose triangles lie flat in c (a corner of a curve that the mesher cut off
+    // with points on both its edges: three source vertices) would start no streamline: it takes
+    // the mean flow of its neighbours instead.
+    const std::vector<Vec2> recovered = velocity_;
+    for (Index v = 0; v < n; ++v) {
+      if (recovered[v].squaredNorm() > 0.0) continue;
+      Vec2 sum = Vec2::Zero();
+      for (Index k = offsets_[v]; k < offsets_[v + 1]; ++k) {
+        for (int i = 0; i < 3; ++i) sum += recovered[mesh.triangles(incident_[k], i)];
+      }
+      velocity_[v] = sum;
+    }
     // On the curves c is constant, so the flow is normal to them: keep only the normal part of
     // the one-sided average there (the normal from the boundary edges at the vertex).
     std::vector<Vec2> normal(n, Vec2::Zero());
@@ -145,6 +159,7 @@ class Tracer {
     record(x);
     Index steps_here = 0, last_triangle = -1;  // a streamline that stalls in one triangle is lost
     for (Index step = 0; step < step_limit_; ++step) {
+      if (step % 1024 == 0) detail::check_interrupt();
       if (t >= 0 && t == last_triangle) {
         if (++steps_here > kStallSteps) return lost;
       } else {
@@ -154,7 +169,7 @@ class Tracer {
         if (kind_[vertex] == target_vertex && vertex != start) return point(vertex);
         t = enter(vertex);
         if (t < 0) {
-          if (!descend_edge(vertex)) return lost;
+          if (!descend_edge(vertex) && !escape_flat(vertex)) return lost;
           record(point(vertex));
           continue;
         }
@@ -262,6 +277,29 @@ class Tracer {
     return true;
   }
 
+  // A vertex whose triangles are all flat in c (a curve's corner the mesher cut off with points
+  // on both of its edges) has no way down: go to the nearest vertex of the same potential,
+  // through such flat triangles, from which the flow or an edge leads on.
+  bool escape_flat(Index& vertex) const {
+    std::vector<Index> queue{vertex};
+    for (std::size_t head = 0; head < queue.size() && queue.size() < 256; ++head) {
+      const Index v = queue[head];
+      for (Index k = offsets_[v]; k < offsets_[v + 1]; ++k) {
+        for (int i = 0; i < 3; ++i) {
+          const Index w = mesh_.triangles(incident_[k], i);
+          if (c_[w] != c_[vertex] || std::find(queue.begin(), queue.end(), w) != queue.end()) continue;
+          Index next = w;
+          if (enter(w) >= 0 || descend_edge(next)) {
+            vertex = w;
+            return true;
+          }
+          queue.push_back(w);
+        }
+      }
+    }
+    return false;
+  }
+
   // RK4 steps are a quarter of the smallest height, so a streamline crosses a triangle in a few
   // of them; hundreds mean it has stalled (where the flow vanishes or turns back at a wall).
   static constexpr Index kStallSteps = 1000;
@@ -297,23 +335,14 @@ DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2
                             "wider than 1e-100 (rescale the curves)");
     }
   }
+  // The region between the curves is only defined for simple ones.
+  detail::require_no_self_intersection(source_points.topRows(ns), closed, "c1");
+  detail::require_no_self_intersection(target_points.topRows(nt), closed, "c2");
   if (closed) {
     detail::require_area(source_points.topRows(ns), "c1");
     detail::require_area(target_points.topRows(nt), "c2");
   }
-  // The region between the curves is only defined for simple ones.
-  if (is_self_intersecting(source_points.topRows(ns), closed)) {
-    detail::invalid("c1", "the curve intersects itself; diffusion mapping needs a simple curve");
-  }
-  if (is_self_intersecting(target_points.topRows(nt), closed)) {
-    detail::invalid("c2", "the curve intersects itself; diffusion mapping needs a simple curve");
-  }
-  if (!(options.mesh_size >= 0.0) || !std::isfinite(options.mesh_size)) {
-    detail::invalid("mesh_size", "must be a finite length >= 0");
-  }
-  if (!(options.mesh_fraction > 0.0) || !std::isfinite(options.mesh_fraction)) {
-    detail::invalid("mesh_fraction", "must be a finite number > 0");
-  }
+  detail::require_diffusion_options(options);
   const Points2 source = source_points.topRows(ns), target = target_points.topRows(nt);
 
   // Boundary loops; input points are numbered source first, then target.
@@ -354,7 +383,12 @@ DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2
       area = std::abs(signed_area(loops[0]));
     }
     const double boundary = perimeter(source, closed) + perimeter(target, closed);
-    max_edge = options.mesh_fraction * 2.0 * area / boundary;
+    // A long thin region (a piece between two contact stretches, say) would get length / gap
+    // times the vertices of a round one of the same gap: the lattice is kept within a budget of
+    // vertices (at 20 per curve point, 40000 at least), still 20 or more across such a gap.
+    const double budget = std::max(4e4, 20.0 * static_cast<double>(ns + nt));
+    const double coarsest = std::sqrt(2.0 / std::sqrt(3.0) * area / budget);
+    max_edge = std::max(options.mesh_fraction * 2.0 * area / boundary, coarsest);
   }
   const detail::RegionMesh mesh = detail::mesh_region(loops, max_edge);
   if (mesh.triangles.rows() == 0) throw GeometryError("the region between the curves is empty");

@@ -6,6 +6,7 @@
 #include <morphomap/surface_queries.hpp>
 
 #include "dirichlet.hpp"
+#include "interrupt_check.hpp"
 #include "shell_mesh.hpp"
 #include "validation.hpp"
 
@@ -147,6 +148,7 @@ class Tracer {
     if (path) path->push_back(x);
     int stalled = 0;
     for (int step = 0; step < kStepLimit; ++step) {
+      if (step % 1024 == 0) detail::check_interrupt();
       const double h = step_[t];
       const Vec3 k1 = direction(t, x);
       if (k1.squaredNorm() == 0.0) return stopped(locate(t, x), x);

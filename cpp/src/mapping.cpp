@@ -10,6 +10,8 @@
 #include <morphomap/transform.hpp>
 
 #include "arc_curve.hpp"
+#include "contact.hpp"
+#include "interrupt_check.hpp"
 #include "validation.hpp"
 
 #include <unsupported/Eigen/FFT>
@@ -28,13 +30,23 @@ std::string method_name(Method method) {
     case Method::normal: return "normal";
     case Method::diffusion: return "diffusion";
     case Method::uniform: return "uniform";
+    case Method::reverse_minimal_distance: return "reverse_minimal_distance";
+    case Method::reverse_normal: return "reverse_normal";
+    case Method::reverse_diffusion: return "reverse_diffusion";
+    case Method::reverse_uniform: return "reverse_uniform";
   }
   return "unknown";
+}
+
+Method reversed(Method method) {
+  const int code = static_cast<int>(method);
+  return static_cast<Method>(code < 4 ? code + 4 : code - 4);
 }
 
 namespace {
 
 using detail::ArcCurve;
+using detail::Meeting;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // A piece of the source (the whole curve, or the stretch between two crossings) with its start
@@ -47,6 +59,9 @@ struct Job {
   Vector fractions;              // uniform: arc position along the source / its length
   Points2 target;
   bool target_closed = false;
+  // The first / last rows of source and target are the two ends of a meeting (a crossing or a
+  // contact stretch), whose own vectors map them: no start point there, either way round.
+  bool shared_begin = false, shared_end = false;
   double anchor = 0.0;           // uniform: target arc position where fraction 0 lands
   int direction = 1;             // uniform: +1 forward along the target, -1 backward
 };
@@ -64,10 +79,25 @@ Points2 start_points(const Job& job) {
   return starts;
 }
 
-Points2 basic_ends(MapMethod method, const Job& job, const Points2& starts) {
+// What every job of one mapping shares.
+struct Settings {
+  double density_threshold = 0.0;
+  double contact_tolerance = -1.0;  // < 0: default_contact_tolerance
+  DiffusionOptions diffusion;
+};
+
+bool all_rows_equal(const Points2& points) {
+  for (Index i = 1; i < points.rows(); ++i) {
+    if (points.row(i) != points.row(0)) return false;
+  }
+  return true;
+}
+
+Points2 basic_ends(MapMethod method, const Job& job, const Points2& starts, const Settings& settings) {
   if (starts.rows() == 0) return Points2(0, 2);
+  // A piece of the target that shrank to a point (two meetings at one place) takes all starts.
+  if (all_rows_equal(job.target)) return job.target.row(0).replicate(starts.rows(), 1);
   const ArcCurve target(job.target, job.target_closed, "c2");
-  if (target.length() == 0.0) return job.target.row(0).replicate(starts.rows(), 1);
   switch (method) {
     case MapMethod::minimal_distance:
       return CurveIndex(job.target, job.target_closed).closest_points(starts).points;
@@ -82,14 +112,15 @@ Points2 basic_ends(MapMethod method, const Job& job, const Points2& starts) {
       return ends;
     }
     case MapMethod::diffusion: {
-      const DiffusionSolution solution = solve_diffusion(job.source, job.target, job.source_closed);
+      const DiffusionSolution solution = solve_diffusion(job.source, job.target, job.source_closed, settings.diffusion);
       Points2 ends(starts.rows(), 2);
       for (std::size_t j = 0; j < job.start_rows.size(); ++j) ends.row(j) = solution.ends.row(job.start_rows[j]);
       return ends;
     }
-    default:
-      detail::invalid("method", "not a basic algorithm");
+    case MapMethod::automatic:
+      break;
   }
+  detail::invalid("method", "not a basic algorithm");
 }
 
 Method basic_method(MapMethod method) {
@@ -97,8 +128,10 @@ Method basic_method(MapMethod method) {
     case MapMethod::minimal_distance: return Method::minimal_distance;
     case MapMethod::normal: return Method::normal;
     case MapMethod::uniform: return Method::uniform;
-    default: return Method::diffusion;
+    case MapMethod::diffusion: return Method::diffusion;
+    case MapMethod::automatic: break;
   }
+  detail::invalid("method", "'auto' is not a basic algorithm");
 }
 
 // Start points per gap: the mean distance from the starts to the target over their mean spacing
@@ -109,9 +142,19 @@ double point_density(const Job& job, const Points2& starts) {
   return spacing > 0.0 ? gap / spacing : 0.0;
 }
 
+// A basic algorithm on one job, from its start points.
+Vectors forward(MapMethod method, const Job& job, const std::vector<double>& start_keys, const Settings& settings) {
+  Vectors v;
+  v.starts = start_points(job);
+  v.keys = start_keys;
+  v.ends = basic_ends(method, job, v.starts, settings);
+  v.methods.assign(v.starts.rows(), basic_method(method));
+  return v;
+}
+
 // A basic algorithm run backwards on one job (the paper's reverse mapping): from the target's
 // points (but shared crossings) to the source, flipped.
-Vectors reverse(MapMethod method, const Job& job, const ArcCurve& whole_source) {
+Vectors reverse(MapMethod method, const Job& job, const ArcCurve& whole_source, const Settings& settings) {
   Job back;
   back.source = job.target;
   back.source_closed = job.target_closed;
@@ -119,15 +162,16 @@ Vectors reverse(MapMethod method, const Job& job, const ArcCurve& whole_source) 
   back.target_closed = job.source_closed;
   const Index n = job.target.rows();
   for (Index i = 0; i < n; ++i) {
-    const bool shared = !job.target_closed && ((i == 0 && job.target.row(0) == job.source.row(0)) ||
-                                               (i == n - 1 && job.target.row(n - 1) == job.source.row(job.source.rows() - 1)));
+    const bool shared =
+        !job.target_closed && ((i == 0 && (job.shared_begin || job.target.row(0) == job.source.row(0))) ||
+                               (i == n - 1 && (job.shared_end || job.target.row(n - 1) == job.source.row(job.source.rows() - 1))));
     if (!shared) back.start_rows.push_back(i);
   }
   Vectors v;
   v.ends = start_points(back);
   if (method == MapMethod::normal) back.normals = normals(back.source, back.source_closed)(back.start_rows, Eigen::all);
-  v.starts = basic_ends(method, back, v.ends);
-  v.methods.assign(v.starts.rows(), basic_method(method));
+  v.starts = basic_ends(method, back, v.ends, settings);
+  v.methods.assign(v.starts.rows(), reversed(basic_method(method)));
   v.keys.assign(v.starts.rows(), std::numeric_limits<double>::infinity());
   std::vector<Index> found;
   for (Index i = 0; i < v.starts.rows(); ++i) {
@@ -139,35 +183,43 @@ Vectors reverse(MapMethod method, const Job& job, const ArcCurve& whole_source) 
     const Vector arcs = CurveIndex(whole_source.points(), whole_source.closed()).closest_points(located).arc_lengths;
     for (std::size_t j = 0; j < found.size(); ++j) v.keys[found[j]] = whole_source.wrap(arcs[j]);
   }
+  // A miss keeps its point on the target (ends), so that it can be found; its start is NaN.
   for (Index i = 0; i < v.starts.rows(); ++i) {
-    if (!v.starts.row(i).allFinite()) v.ends.row(i).setConstant(kNaN);
+    if (!v.starts.row(i).allFinite()) v.starts.row(i).setConstant(kNaN);
   }
   return v;
 }
 
-// One job with one algorithm; "auto" is the paper's Algorithm 1 on the job: normal mapping, and
-// reverse diffusion instead when normal mapping gives crossings or misses. With a density
+bool complete(const Vectors& v) { return v.starts.allFinite() && v.ends.allFinite(); }
+
+// One job with one algorithm. "auto" is the paper's Algorithm 1 on the job: normal mapping, and
+// reverse diffusion instead when normal mapping gives crossings or misses (with a density
 // threshold, the first attempt is reverse minimal distance where the start points are denser
-// than the threshold (the paper's "limiting case of an infinite number of points").
+// than the threshold: the paper's "limiting case of an infinite number of points"). Where reverse
+// diffusion fails on a piece (its mesh cannot be made, streamlines stall), "auto" still answers:
+// forward diffusion, which is crossing-free too; then the first attempt if it missed nothing
+// (crossings and all); then minimal distance, which always finds a point.
 Vectors run(MapMethod method, const Job& job, const std::vector<double>& start_keys,
-            const ArcCurve& whole_source, double density_threshold) {
-  const bool automatic = method == MapMethod::automatic;
-  Vectors v;
-  v.starts = start_points(job);
-  v.keys = start_keys;
-  if (automatic && density_threshold > 0.0 && v.starts.rows() > 0 &&
-      point_density(job, v.starts) > density_threshold) {
-    v = reverse(MapMethod::minimal_distance, job, whole_source);
-  } else {
-    const MapMethod first = automatic ? MapMethod::normal : method;
-    v.ends = basic_ends(first, job, v.starts);
-    v.methods.assign(v.starts.rows(), basic_method(first));
+            const ArcCurve& whole_source, const Settings& settings) {
+  detail::check_interrupt();
+  if (method != MapMethod::automatic) return forward(method, job, start_keys, settings);
+  if (job.start_rows.empty()) return forward(MapMethod::normal, job, start_keys, settings);
+  const Vectors first = settings.density_threshold > 0.0 &&
+                                point_density(job, start_points(job)) > settings.density_threshold
+                            ? reverse(MapMethod::minimal_distance, job, whole_source, settings)
+                            : forward(MapMethod::normal, job, start_keys, settings);
+  if (complete(first) && count_crossings(first.starts, first.ends) == 0) return first;
+  for (const bool backwards : {true, false}) {
+    try {
+      Vectors v = backwards ? reverse(MapMethod::diffusion, job, whole_source, settings)
+                            : forward(MapMethod::diffusion, job, start_keys, settings);
+      if (complete(v)) return v;
+    } catch (const GeometryError&) {
+    } catch (const InvalidInput&) {  // a piece the region of which is not what diffusion needs
+    }
   }
-  if (automatic && v.starts.rows() > 0 &&
-      (!v.ends.allFinite() || !v.starts.allFinite() || count_crossings(v.starts, v.ends) > 0)) {
-    return reverse(MapMethod::diffusion, job, whole_source);
-  }
-  return v;
+  if (complete(first)) return first;
+  return forward(MapMethod::minimal_distance, job, start_keys, settings);
 }
 
 // Closed curves without a known pair of anchors: the start of the target (walking in direction)
@@ -201,26 +253,6 @@ int relative_direction(const ArcCurve& source, const ArcCurve& target) {
   return orientation(source.points()) == orientation(target.points()) ? 1 : -1;
 }
 
-// Positions of the crossings on the target, in the order met along the source, walk the target
-// monotonically in the given direction (otherwise the segments cannot be paired).
-bool pairs_in_order(const ArcCurve& target, const Vector& on_target, int direction) {
-  const Index k = on_target.size();
-  if (target.closed()) {
-    double previous = 0.0;
-    for (Index j = 1; j < k; ++j) {
-      const double d = direction > 0 ? target.forward(on_target[0], on_target[j])
-                                     : target.forward(on_target[j], on_target[0]);
-      if (!(d > previous)) return false;
-      previous = d;
-    }
-    return true;
-  }
-  for (Index j = 1; j < k; ++j) {
-    if (!(on_target[j] > on_target[j - 1])) return false;
-  }
-  return true;
-}
-
 // Stacks the vectors of all jobs in the order of their keys (arc position of the start along the
 // source; the reverse-diffusion vectors of "auto" fall in among the others).
 Vectors gather(std::vector<Vectors>& parts) {
@@ -248,22 +280,31 @@ Vectors gather(std::vector<Vectors>& parts) {
 
 Vectors map_directed(const Points2& source_points, const Points2& target_points, MapMethod method,
                      bool closed, bool split, const std::optional<std::pair<Vec2, Vec2>>& anchors,
-                     double density_threshold) {
+                     const Settings& settings) {
   const ArcCurve source(source_points, closed, "c1");
   const ArcCurve target(target_points, closed, "c2");
   const Index n = source.size();
   const bool wants_normals = method == MapMethod::normal || method == MapMethod::automatic;
   const Points2 source_normals = wants_normals ? normals(source.points(), closed) : Points2();
-  const int direction = closed && (split || method == MapMethod::uniform)
-                            ? relative_direction(source, target)
-                            : 1;
+  const int direction = closed ? relative_direction(source, target) : 1;
 
   CurveIntersections crossings;
   if (split || (closed && method == MapMethod::uniform)) {
     crossings = curve_intersections(source.points(), target.points(), closed);
   }
   const Index k = crossings.points.rows();
-  const bool pieces = split && k > 0 && pairs_in_order(target, crossings.arc_lengths2, direction);
+  // Where the curves meet: the crossings (when splitting) and, always, the stretches where they
+  // touch or run together, which no region between them spans.
+  const double tolerance = settings.contact_tolerance >= 0.0 ? settings.contact_tolerance
+                                                             : detail::default_contact_tolerance(source, target);
+  const std::vector<Meeting> found =
+      detail::find_meetings(source, target, split ? crossings : CurveIntersections(), tolerance);
+  bool in_order = true;
+  std::vector<Meeting> meetings = detail::meetings_in_order(found, target, direction, &in_order);
+  const bool contact = std::any_of(found.begin(), found.end(), [](const Meeting& m) { return !m.crossing; });
+  // Crossings alone that do not pair up in order: map the whole curves (diffusion handles
+  // crossing curves as one region).
+  if (!in_order && !contact) meetings.clear();
 
   auto add_starts = [&](Job& job, const std::vector<Index>& points, Index first_row) {
     for (std::size_t j = 0; j < points.size(); ++j) job.start_rows.push_back(first_row + j);
@@ -273,7 +314,7 @@ Vectors map_directed(const Points2& source_points, const Points2& target_points,
     }
   };
 
-  if (!pieces) {
+  if (meetings.empty()) {
     Job job;
     job.source = source.points();
     job.source_closed = closed;
@@ -300,92 +341,142 @@ Vectors map_directed(const Points2& source_points, const Points2& target_points,
       job.fractions.resize(n);
       for (Index i = 0; i < n; ++i) job.fractions[i] = source.forward(from, source.arc(i)) / source.length();
     }
-    std::vector<Vectors> parts{run(method, job, keys, source, density_threshold)};
+    std::vector<Vectors> parts{run(method, job, keys, source, settings)};
     return gather(parts);
   }
 
-  // Split: piece p of the source runs from bound[p] to bound[p + 1] and maps onto the target
-  // between target_bound[p] and target_bound[p + 1]; the crossings map onto themselves.
-  std::vector<double> bound, target_bound;
-  std::vector<char> bound_is_crossing;
-  if (!closed) bound.push_back(0.0), target_bound.push_back(0.0), bound_is_crossing.push_back(0);
-  for (Index j = 0; j < k; ++j) {
-    bound.push_back(crossings.arc_lengths1[j]);
-    target_bound.push_back(crossings.arc_lengths2[j]);
-    bound_is_crossing.push_back(1);
-  }
-  if (closed) {
-    bound.push_back(crossings.arc_lengths1[0] + source.length());
-    target_bound.push_back(crossings.arc_lengths2[0]);
-    bound_is_crossing.push_back(1);
-  } else {
-    bound.push_back(source.length());
-    target_bound.push_back(target.length());
-    bound_is_crossing.push_back(0);
-  }
-  const Index piece_count = static_cast<Index>(bound.size()) - 1;
-  const std::vector<double> cuts(closed ? bound.begin() : bound.begin() + 1, bound.end() - 1);
-  auto crossing_at = [&](Index b) -> Vec2 {  // the crossing that bound b stands for
-    return crossings.points.row(closed ? b % k : b - 1).transpose();
+  // Split: each piece runs from the end of one meeting to the start of the next (open curves also
+  // from their start to the first and from the last to their end) and maps onto the target
+  // between the same two meetings. A crossing maps onto itself and is a start point of its own;
+  // the source points on a contact stretch map to their closest point on the target.
+  const Index count = static_cast<Index>(meetings.size());
+  struct End {
+    double s, t;  // arc positions on source and target
+    Vec2 p, q;    // the points there
+    bool meeting;
   };
+  std::vector<std::pair<End, End>> pieces;
+  auto begin_of = [&](const Meeting& m, double shift) {
+    return End{m.source_begin + shift, m.target_begin, m.source_point_begin, m.target_point_begin, true};
+  };
+  auto end_of = [&](const Meeting& m) {
+    return End{m.source_end, m.target_end, m.source_point_end, m.target_point_end, true};
+  };
+  if (closed) {
+    for (Index p = 0; p < count; ++p) {
+      pieces.emplace_back(end_of(meetings[p]), begin_of(meetings[(p + 1) % count], p + 1 == count ? source.length() : 0.0));
+    }
+  } else {
+    const Index last = n - 1;
+    pieces.emplace_back(End{0.0, 0.0, source.points().row(0).transpose(), target.points().row(0).transpose(), false},
+                        begin_of(meetings[0], 0.0));
+    for (Index p = 0; p + 1 < count; ++p) pieces.emplace_back(end_of(meetings[p]), begin_of(meetings[p + 1], 0.0));
+    pieces.emplace_back(end_of(meetings[count - 1]),
+                        End{source.length(), target.length(), source.points().row(last).transpose(),
+                            target.points().row(target.size() - 1).transpose(), false});
+  }
 
-  // Each source point goes to the piece it lies in; a point that is (within rounding) a crossing
-  // stays where it is, as the crossings do.
-  const double coincident = 1e-12 * source.length();
-  std::vector<std::vector<Index>> members(piece_count);
   std::vector<Vectors> parts(1);
   Vectors& fixed = parts[0];
-  std::vector<Vec2> fixed_points;
-  for (Index j = 0; j < k; ++j) {
-    fixed_points.push_back(crossings.points.row(j).transpose());
-    fixed.keys.push_back(crossings.arc_lengths1[j]);
+  std::vector<char> on_stretch(n, 0);
+  std::vector<Vec2> fixed_starts, fixed_ends;
+  std::vector<Method> fixed_methods;
+  const Method crossing_method = basic_method(method == MapMethod::automatic ? MapMethod::normal : method);
+  for (const Meeting& m : meetings) {
+    if (m.crossing) {
+      fixed_starts.push_back(m.source_point_begin), fixed_ends.push_back(m.source_point_begin);
+      fixed.keys.push_back(m.source_begin), fixed_methods.push_back(crossing_method);
+      continue;
+    }
+    for (Index v = m.first_vertex;; v = (v + 1) % n) {
+      on_stretch[v] = 1;
+      if (v == m.last_vertex) break;
+    }
   }
+  std::vector<Index> stretch_rows;
   for (Index i = 0; i < n; ++i) {
+    if (on_stretch[i]) stretch_rows.push_back(i);
+  }
+  if (!stretch_rows.empty()) {
+    const Points2 queries = source.points()(stretch_rows, Eigen::all);
+    const Points2 closest = CurveIndex(target.points(), closed).closest_points(queries).points;
+    for (std::size_t j = 0; j < stretch_rows.size(); ++j) {
+      fixed_starts.push_back(queries.row(j).transpose()), fixed_ends.push_back(closest.row(j).transpose());
+      fixed.keys.push_back(source.arc(stretch_rows[j])), fixed_methods.push_back(Method::minimal_distance);
+    }
+  }
+  fixed.starts.resize(fixed_starts.size(), 2);
+  fixed.ends.resize(fixed_ends.size(), 2);
+  for (std::size_t j = 0; j < fixed_starts.size(); ++j) {
+    fixed.starts.row(j) = fixed_starts[j].transpose(), fixed.ends.row(j) = fixed_ends[j].transpose();
+  }
+  fixed.methods = std::move(fixed_methods);
+
+  // Each other source point goes to the piece it lies in; a point that is (within rounding) a
+  // crossing stays where it is, as the crossings do.
+  const double coincident = 1e-12 * source.length();
+  std::vector<double> begins(count);
+  for (Index p = 0; p < count; ++p) begins[p] = meetings[p].source_begin;
+  std::vector<std::vector<Index>> members(pieces.size());
+  for (Index i = 0; i < n; ++i) {
+    if (on_stretch[i]) continue;
     const double s = source.arc(i);
-    const Index after = std::upper_bound(cuts.begin(), cuts.end(), s) - cuts.begin();
+    const Index after = std::upper_bound(begins.begin(), begins.end(), s) - begins.begin();
     bool on_crossing = false;
     for (Index c : {after - 1, after}) {
-      if (c >= 0 && c < k && source.between(s, crossings.arc_lengths1[c]) <= coincident) on_crossing = true;
+      if (c >= 0 && c < count && meetings[c].crossing && source.between(s, meetings[c].source_begin) <= coincident) {
+        on_crossing = true;
+      }
     }
-    if (!on_crossing) members[closed ? (after == 0 ? piece_count - 1 : after - 1) : after].push_back(i);
+    if (on_crossing) continue;
+    members[closed ? (after == 0 ? count - 1 : after - 1) : after].push_back(i);
   }
-  fixed.starts.resize(k, 2);
-  for (Index j = 0; j < k; ++j) fixed.starts.row(j) = fixed_points[j].transpose();
-  fixed.ends = fixed.starts;
-  fixed.methods.assign(k, basic_method(method == MapMethod::automatic ? MapMethod::normal : method));
 
-  for (Index p = 0; p < piece_count; ++p) {
+  for (std::size_t p = 0; p < pieces.size(); ++p) {
     std::vector<Index>& m = members[p];
     if (m.empty()) continue;
+    const End &from = pieces[p].first, &to = pieces[p].second;
     // Along the piece: the closing piece of a closed curve wraps past the first point.
     std::stable_sort(m.begin(), m.end(), [&](Index a, Index b) {
-      return source.forward(bound[p], source.arc(a)) < source.forward(bound[p], source.arc(b));
+      return source.forward(from.s, source.arc(a)) < source.forward(from.s, source.arc(b));
     });
     Job job;
-    const Index offset = bound_is_crossing[p] ? 1 : 0;
-    job.source.resize(offset + m.size() + (bound_is_crossing[p + 1] ? 1 : 0), 2);
-    if (offset) job.source.row(0) = crossing_at(p).transpose();
+    const Index offset = from.meeting ? 1 : 0;
+    job.source.resize(offset + m.size() + (to.meeting ? 1 : 0), 2);
+    if (from.meeting) job.source.row(0) = from.p.transpose();
     for (std::size_t j = 0; j < m.size(); ++j) job.source.row(offset + j) = source.points().row(m[j]);
-    if (bound_is_crossing[p + 1]) job.source.row(job.source.rows() - 1) = crossing_at(p + 1).transpose();
+    if (to.meeting) job.source.row(job.source.rows() - 1) = to.p.transpose();
     add_starts(job, m, offset);
-    const double a = target_bound[p], b = target_bound[p + 1];
-    job.target = closed && direction < 0 ? Points2(target.piece(b, a).colwise().reverse()) : target.piece(a, b);
-    // The pieces meet exactly at the crossings (the target's are found by arc length).
-    if (bound_is_crossing[p]) job.target.row(0) = crossing_at(p).transpose();
-    if (bound_is_crossing[p + 1]) job.target.row(job.target.rows() - 1) = crossing_at(p + 1).transpose();
+    job.shared_begin = from.meeting, job.shared_end = to.meeting;
+    job.target = closed && direction < 0 ? Points2(target.piece(to.t, from.t).colwise().reverse()) : target.piece(from.t, to.t);
+    // The pieces end exactly at the meetings (the target's are found by arc length).
+    if (from.meeting) job.target.row(0) = from.q.transpose();
+    if (to.meeting) job.target.row(job.target.rows() - 1) = to.q.transpose();
     if (method == MapMethod::uniform) {
-      const double length = bound[p + 1] - bound[p];
+      const double length = to.s - from.s;
       job.fractions.resize(m.size());
       for (std::size_t j = 0; j < m.size(); ++j) {
-        const double along = closed ? source.forward(bound[p], source.arc(m[j])) : source.arc(m[j]) - bound[p];
+        const double along = closed ? source.forward(from.s, source.arc(m[j])) : source.arc(m[j]) - from.s;
         job.fractions[j] = length > 0 ? along / length : 0.0;
       }
     }
     std::vector<double> keys(m.size());
     for (std::size_t j = 0; j < m.size(); ++j) keys[j] = source.arc(m[j]);
-    parts.push_back(run(method, job, keys, source, density_threshold));
+    parts.push_back(run(method, job, keys, source, settings));
   }
   return gather(parts);
+}
+
+// Puts the finite rows of points onto the curve (their closest points).
+void project_onto(Points2& points, const Points2Ref& curve, bool closed) {
+  std::vector<Index> rows;
+  for (Index i = 0; i < points.rows(); ++i) {
+    if (points.row(i).allFinite()) rows.push_back(i);
+  }
+  if (rows.empty()) return;
+  const Points2 queries = points(rows, Eigen::all);
+  const Points2 on_curve = CurveIndex(curve, closed).closest_points(queries).points;
+  for (std::size_t j = 0; j < rows.size(); ++j) points.row(rows[j]) = on_curve.row(j);
 }
 
 }  // namespace
@@ -393,16 +484,19 @@ Vectors map_directed(const Points2& source_points, const Points2& target_points,
 DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2,
                               const CurveMappingOptions& options) {
   const bool closed = options.closed;
-  const Index n1 = detail::require_curve(c1, closed, "c1");
-  const Index n2 = detail::require_curve(c2, closed, "c2");
+  const Index n1 = detail::require_simple_curve(c1, closed, "c1");
+  const Index n2 = detail::require_simple_curve(c2, closed, "c2");
   if (options.n < 0 || (options.n > 0 && options.n < (closed ? 3 : 2))) {
     detail::invalid("n", "must be 0 (use the given points) or at least " +
                               std::string(closed ? "3" : "2") + ", got " + std::to_string(options.n));
   }
-  if (closed) {
-    detail::require_area(c1.topRows(n1), "c1");
-    detail::require_area(c2.topRows(n2), "c2");
+  if (!(options.density_threshold >= 0.0) || !std::isfinite(options.density_threshold)) {
+    detail::invalid("density_threshold", "must be a finite number >= 0 (0: off)");
   }
+  if (std::isnan(options.contact_tolerance) || std::isinf(options.contact_tolerance)) {
+    detail::invalid("contact_tolerance", "must be a finite length >= 0, or negative for the default");
+  }
+  detail::require_diffusion_options(options.diffusion);
   Points2 a = options.n > 0 ? resample(c1, options.n, closed) : Points2(c1.topRows(n1));
   const Points2 b = options.n > 0 ? resample(c2, options.n, closed) : Points2(c2.topRows(n2));
 
@@ -421,21 +515,26 @@ DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2,
     anchors = options.reverse ? std::make_pair(on_c2, on_c1) : std::make_pair(on_c1, on_c2);
   }
 
+  Settings settings;
+  settings.density_threshold = options.density_threshold;
+  settings.contact_tolerance = options.contact_tolerance;
+  settings.diffusion = options.diffusion;
+  Vectors v = options.reverse ? map_directed(b, a, options.method, closed, options.split, anchors, settings)
+                              : map_directed(a, b, options.method, closed, options.split, anchors, settings);
   DisplacementField2 field;
-  if (!(options.density_threshold >= 0.0) || !std::isfinite(options.density_threshold)) {
-    detail::invalid("density_threshold", "must be a finite number >= 0 (0: off)");
-  }
-  Vectors v = options.reverse
-                  ? map_directed(b, a, options.method, closed, options.split, anchors, options.density_threshold)
-                  : map_directed(a, b, options.method, closed, options.split, anchors, options.density_threshold);
   field.starts = std::move(options.reverse ? v.ends : v.starts);
   field.ends = std::move(options.reverse ? v.starts : v.ends);
-  // A reverse vector that found no start on C1 is missing as a whole.
-  for (Index i = 0; options.reverse && i < field.ends.rows(); ++i) {
-    if (!field.valid(i)) field.starts.row(i).setConstant(kNaN), field.ends.row(i).setConstant(kNaN);
+  field.methods = std::move(v.methods);
+  if (options.reverse) {
+    for (Method& m : field.methods) m = reversed(m);
   }
   if (options.transform) field.starts = similarity.apply_inverse(field.starts);
-  field.methods = std::move(v.methods);
+  // Resampled curves cut the corners of the given ones: the points found on them go onto the
+  // curves the caller passed, so that quality(field, c1, c2) measures the field on those.
+  if (options.n > 0) {
+    project_onto(field.starts, c1.topRows(n1), closed);
+    project_onto(field.ends, c2.topRows(n2), closed);
+  }
   return field;
 }
 

@@ -151,15 +151,15 @@ Index count_folds(const Points3Ref& starts, const Points3Ref& ends, const FacesR
 
 Index count_folds(const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, const Points3Ref& v1,
                   const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2) {
-  check_closed_surface(v1, f1, "s1");
-  check_closed_surface(v2, f2, "s2");
+  detail::require_outward(check_closed_surface(v1, f1, "s1"), "s1");
+  detail::require_outward(check_closed_surface(v2, f2, "s2"), "s2");
   return count_folds(starts, ends, faces, v1, f1, SurfaceIndex(v1, f1), v2, f2, SurfaceIndex(v2, f2));
 }
 
 SurfaceQuality quality(const DisplacementField3& field, const Points3Ref& v1, const FacesRef& f1,
                        const Points3Ref& v2, const FacesRef& f2) {
-  check_closed_surface(v1, f1, "s1");
-  check_closed_surface(v2, f2, "s2");
+  detail::require_outward(check_closed_surface(v1, f1, "s1"), "s1");
+  detail::require_outward(check_closed_surface(v2, f2, "s2"), "s2");
   if (field.ends.rows() != field.starts.rows() || field.starts.cols() != 3 || field.ends.cols() != 3) {
     detail::invalid("field", "starts and ends must both have shape (M, 3)");
   }

@@ -1,6 +1,8 @@
 // The only translation unit with CGAL's 2D mesher: it compiles slowly.
 #include "region_mesh.hpp"
 
+#include "interrupt_check.hpp"
+
 #include <morphomap/curve_queries.hpp>
 #include <morphomap/errors.hpp>
 
@@ -261,6 +263,7 @@ RegionMesh mesh_region(const std::vector<Points2>& loops, double max_edge) {
   try {
     Cdt::Face_handle hint;
     for (const std::size_t i : order) {
+      if (i % 4096 == 0) check_interrupt();
       const auto v = cdt.insert(points[i], hint);
       if (v->info().input < 0 || static_cast<Index>(i) < v->info().input) v->info().input = static_cast<Index>(i);
       v->info().kind = 2;
@@ -314,6 +317,7 @@ RegionMesh mesh_region(const std::vector<Points2>& loops, double max_edge) {
       CGAL::spatial_sort(seed_order.begin(), seed_order.end(), SortTraits(CGAL::make_property_map(seeds)));
       Cdt::Face_handle hint;
       for (const std::size_t i : seed_order) {
+        if (i % 4096 == 0) check_interrupt();
         const auto v = cdt.insert(seeds[i], hint);
         if (v->info().kind == 0) v->info().kind = i < on_lattice ? 1 : 2;
         hint = v->face();
@@ -326,6 +330,7 @@ RegionMesh mesh_region(const std::vector<Points2>& loops, double max_edge) {
     mesher.init(true);
     while (mesher.try_one_step_refine_mesh()) {
       if (cdt.number_of_vertices() > kMaxVertices) too_many_vertices();
+      check_interrupt();
     }
   } catch (const CGAL::Failure_exception& e) {
     throw GeometryError(std::string("meshing the region between the curves failed: ") + e.what());

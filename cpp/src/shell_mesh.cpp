@@ -168,6 +168,14 @@ ShellMesh to_shell_mesh(const C3t3& c3t3, PatchKind patch_kind) {
 
 }  // namespace
 
+bool surface_self_intersects(const Points3Ref& vertices, const FacesRef& faces) {
+  try {
+    return CGAL::Polygon_mesh_processing::does_self_intersect(to_surface_mesh(vertices, faces));
+  } catch (const CGAL::Failure_exception& e) {
+    throw GeometryError(std::string("testing the surface for self-intersections failed: ") + e.what());
+  }
+}
+
 Nesting classify_nesting(const Points3Ref& source_vertices, const FacesRef& source_faces,
                          const Points3Ref& target_vertices, const FacesRef& target_faces) {
   try {

@@ -36,6 +36,13 @@ void require_face_indices(const FacesRef& faces, Index vertex_count, const char*
   }
 }
 
+void require_outward(double volume, const char* name) {
+  if (!(volume > 0.0)) {
+    invalid(name, "the faces are oriented inwards (the enclosed volume comes out as " + std::to_string(volume) +
+                      "): reverse the order of the vertices of every face (faces[:, ::-1]; trimesh: mesh.invert())");
+  }
+}
+
 }  // namespace detail
 
 using detail::V3;
@@ -108,6 +115,45 @@ double check_closed_surface(const Points3Ref& vertices, const FacesRef& faces, c
       detail::invalid(name, "the surface is not closed: edge " + edge + " belongs to one face only "
                             "(or its neighbour is oriented the other way)");
     }
+  }
+  // Every vertex used (an unused one has no normal, and no place on the surface).
+  std::vector<char> used(vertices.rows(), 0);
+  for (Index j = 0; j < faces.rows(); ++j) {
+    for (int k = 0; k < 3; ++k) used[faces(j, k)] = 1;
+  }
+  const auto unused = std::find(used.begin(), used.end(), 0);
+  if (unused != used.end()) {
+    detail::invalid(name, "vertex " + std::to_string(unused - used.begin()) + " (of " + std::to_string(vertices.rows()) +
+                              ") is used by no face: drop unused vertices first (trimesh: "
+                              "mesh.remove_unreferenced_vertices())");
+  }
+  // One shell: debris segmented with the organ is a second closed component.
+  std::vector<Index> parent(vertices.rows());
+  for (Index i = 0; i < vertices.rows(); ++i) parent[i] = i;
+  auto root = [&](Index i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  for (Index j = 0; j < faces.rows(); ++j) {
+    for (int k = 1; k < 3; ++k) {
+      const Index a = root(faces(j, 0)), b = root(faces(j, k));
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  }
+  std::vector<Index> faces_of(vertices.rows(), 0);
+  for (Index j = 0; j < faces.rows(); ++j) ++faces_of[root(faces(j, 0))];
+  std::vector<Index> sizes;
+  for (Index i = 0; i < vertices.rows(); ++i) {
+    if (faces_of[i] > 0) sizes.push_back(faces_of[i]);
+  }
+  if (sizes.size() > 1) {
+    std::sort(sizes.rbegin(), sizes.rend());
+    std::string listed;
+    for (std::size_t k = 0; k < sizes.size() && k < 5; ++k) listed += (k ? ", " : "") + std::to_string(sizes[k]);
+    if (sizes.size() > 5) listed += ", ...";
+    detail::invalid(name, "the surface has " + std::to_string(sizes.size()) + " separate components (" + listed +
+                              " faces), as when debris is segmented with the organ: pass one object "
+                              "(morphomap.split_components(mesh) separates them)");
   }
   return volume / 6.0;
 }

@@ -5,12 +5,14 @@
 #include <morphomap/surface_mapping.hpp>
 #include <morphomap/surface_queries.hpp>
 
+#include "shell_mesh.hpp"
 #include "validation.hpp"
 
 #include <morphomap/errors.hpp>
 
 #include <cmath>
 #include <limits>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -69,37 +71,67 @@ DisplacementField3 basic(MapMethod method, const Surface& source, const Surface&
   return field;
 }
 
-// A field from one surface to another turned round (starts and ends swapped, rows and faces kept);
-// a row that found nothing is NaN as a whole.
+// A field from one surface to another turned round (starts and ends swapped, rows and faces kept,
+// methods named the other way round); a row that found nothing keeps its known point, the other
+// end NaN.
 DisplacementField3 flipped(DisplacementField3 field) {
   std::swap(field.starts, field.ends);
-  for (Index i = 0; i < field.size(); ++i) {
-    if (!field.valid(i)) field.starts.row(i).setConstant(kNaN), field.ends.row(i).setConstant(kNaN);
-  }
+  for (Method& m : field.methods) m = reversed(m);
   return field;
+}
+
+bool complete(const DisplacementField3& field) {
+  for (Index i = 0; i < field.size(); ++i) {
+    if (!field.valid(i)) return false;
+  }
+  return true;
+}
+
+// "auto": normal mapping where it misses nothing and folds no triangle; else reverse diffusion
+// (the paper's choice), else diffusion (both fold-free by construction), else the normal mapping
+// if it missed nothing, else minimal distance (which always finds a point): it answers wherever a
+// basic algorithm does.
+DisplacementField3 automatic(const Surface& source, const Surface& target, const SurfaceIndex& target_index,
+                             double mesh_size) {
+  DisplacementField3 normal = basic(MapMethod::normal, source, target, target_index, mesh_size);
+  const SurfaceIndex source_index(source.vertices, source.faces);
+  const bool missed = !complete(normal);
+  if (!missed && count_folds(normal.starts, normal.ends, normal.faces, source.vertices, source.faces, source_index,
+                             target.vertices, target.faces, target_index) == 0) {
+    return normal;
+  }
+  for (const bool backwards : {true, false}) {
+    try {
+      DisplacementField3 field = backwards ? flipped(basic(MapMethod::diffusion, target, source, source_index, mesh_size))
+                                           : basic(MapMethod::diffusion, source, target, target_index, mesh_size);
+      if (complete(field)) return field;
+    } catch (const GeometryError&) {
+    } catch (const InvalidInput&) {  // surfaces whose region diffusion cannot mesh (they coincide in part, say)
+    }
+  }
+  if (!missed) return normal;
+  return basic(MapMethod::minimal_distance, source, target, target_index, mesh_size);
 }
 
 DisplacementField3 directed(MapMethod method, const Surface& source, const Surface& target, double mesh_size) {
   const SurfaceIndex target_index(target.vertices, target.faces);
-  if (method != MapMethod::automatic) return basic(method, source, target, target_index, mesh_size);
-  DisplacementField3 field = basic(MapMethod::normal, source, target, target_index, mesh_size);
-  bool missed = false;
-  for (Index i = 0; i < field.size() && !missed; ++i) missed = !field.valid(i);
-  const SurfaceIndex source_index(source.vertices, source.faces);
-  if (!missed && count_folds(field.starts, field.ends, field.faces, source.vertices, source.faces, source_index,
-                             target.vertices, target.faces, target_index) == 0) {
-    return field;
-  }
-  // Reverse diffusion: streamlines from the target's vertices back to the source, turned round.
-  return flipped(basic(MapMethod::diffusion, target, source, source_index, mesh_size));
+  if (method == MapMethod::automatic) return automatic(source, target, target_index, mesh_size);
+  return basic(method, source, target, target_index, mesh_size);
 }
 
 }  // namespace
 
 DisplacementField3 map_surfaces(const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2,
                                 const SurfaceMappingOptions& options) {
-  check_closed_surface(v1, f1, "s1");
-  check_closed_surface(v2, f2, "s2");
+  detail::require_outward(check_closed_surface(v1, f1, "s1"), "s1");
+  detail::require_outward(check_closed_surface(v2, f2, "s2"), "s2");
+  for (const auto& [vertices, faces, name] : {std::tuple(&v1, &f1, "s1"), std::tuple(&v2, &f2, "s2")}) {
+    if (detail::surface_self_intersects(*vertices, *faces)) {
+      detail::invalid(name, "the surface intersects itself; the mapping needs a simple closed surface "
+                            "(a mask contoured without smoothing can touch itself at a voxel edge: "
+                            "smooth or remesh it)");
+    }
+  }
   if (options.method == MapMethod::uniform) {
     detail::invalid("method", "uniform mapping has no 3D form; use 'minimal_distance', 'normal', 'diffusion' or 'auto'");
   }

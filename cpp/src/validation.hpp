@@ -2,6 +2,7 @@
 // Input checks shared by the kernels. Messages start with the argument's name so that the
 // Python layer can pass them on unchanged.
 #include <morphomap/errors.hpp>
+#include <morphomap/laplace.hpp>
 #include <morphomap/types.hpp>
 
 #include <string>
@@ -26,6 +27,22 @@ Points2 without_repeats(const Points2Ref& points, bool closed, const char* name)
 // A closed curve (as checked by require_curve) whose area is not (nearly) zero against the square
 // of its length: no orientation to trust, no region to mesh otherwise.
 void require_area(const Points2Ref& points, const char* name);
+
+// require_curve, then: one loop (no point repeated apart from consecutive repeats, as when two
+// contours are concatenated) and no self-intersection, each with a message that gives the count
+// and where. Returns curve_size.
+Index require_simple_curve(const Points2Ref& points, bool closed, const char* name);
+
+// The curve, with consecutive repeats dropped, meets itself: InvalidInput naming `name`, with
+// the number of pairs of segments that meet and the first of them.
+void require_no_self_intersection(const Points2Ref& points, bool closed, const char* name);
+
+// A closed surface's signed volume (check_closed_surface) is positive: its faces face outwards.
+// Mapping and quality need that (an inward surface would fold every triangle).
+void require_outward(double volume, const char* name);
+
+// A diffusion mesh size >= 0 and a mesh fraction > 0, both finite.
+void require_diffusion_options(const DiffusionOptions& options);
 
 // Number of worker threads the kernels use.
 int thread_count();

@@ -5,6 +5,8 @@
 
 #include <morphomap/laplace3d.hpp>
 
+#include "interrupt_guard.hpp"
+
 namespace py = pybind11;
 using namespace morphomap;
 
@@ -17,6 +19,7 @@ void bind_diffusion3d(py::module_& m) {
         options.mesh_size = mesh_size;
         options.keep_streamlines = keep_streamlines;
         ShellDiffusionSolution solution;
+        InterruptGuard interruptible;
         {
           py::gil_scoped_release release;
           solution = solve_diffusion_3d(source_vertices, source_faces, target_vertices, target_faces, options);

@@ -7,6 +7,10 @@
 #include <morphomap/laplace.hpp>
 #include <morphomap/mapping.hpp>
 
+#include "methods.hpp"
+
+#include "interrupt_guard.hpp"
+
 namespace py = pybind11;
 using namespace morphomap;
 
@@ -27,7 +31,8 @@ void bind_mapping(py::module_& m) {
   m.def(
       "map_curves",
       [](const Points2Ref& c1, const Points2Ref& c2, const std::string& method, bool closed, Index n,
-         bool reverse, bool transform, bool split, std::optional<Vec2> anchor, double density_threshold) {
+         bool reverse, bool transform, bool split, std::optional<Vec2> anchor, double density_threshold,
+         double contact_tolerance, double mesh_size, double mesh_fraction) {
         CurveMappingOptions options;
         options.method = map_method(method);
         options.closed = closed;
@@ -37,18 +42,21 @@ void bind_mapping(py::module_& m) {
         options.split = split;
         options.anchor = anchor;
         options.density_threshold = density_threshold;
+        options.contact_tolerance = contact_tolerance;
+        options.diffusion.mesh_size = mesh_size;
+        options.diffusion.mesh_fraction = mesh_fraction;
         DisplacementField2 field;
+        InterruptGuard interruptible;
         {
           py::gil_scoped_release release;
           field = map_curves(c1, c2, options);
         }
-        Eigen::Matrix<std::int8_t, Eigen::Dynamic, 1> codes(field.methods.size());
-        for (std::size_t i = 0; i < field.methods.size(); ++i) codes[i] = static_cast<std::int8_t>(field.methods[i]);
-        return py::make_tuple(std::move(field.starts), std::move(field.ends), std::move(codes));
+        return py::make_tuple(std::move(field.starts), std::move(field.ends), method_codes(field.methods));
       },
       py::arg("c1"), py::arg("c2"), py::arg("method"), py::arg("closed"), py::arg("n"),
       py::arg("reverse"), py::arg("transform"), py::arg("split"), py::arg("anchor"),
-      py::arg("density_threshold"));
+      py::arg("density_threshold"), py::arg("contact_tolerance"), py::arg("mesh_size"),
+      py::arg("mesh_fraction"));
 
   m.def(
       "solve_diffusion",
@@ -59,6 +67,7 @@ void bind_mapping(py::module_& m) {
         options.mesh_fraction = mesh_fraction;
         options.keep_streamlines = keep_streamlines;
         DiffusionSolution solution;
+        InterruptGuard interruptible;
         {
           py::gil_scoped_release release;
           solution = solve_diffusion(source, target, closed, options);

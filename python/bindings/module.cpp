@@ -6,6 +6,8 @@
 #include <morphomap/build_info.hpp>
 #include <morphomap/errors.hpp>
 
+#include "interrupt_guard.hpp"
+
 namespace py = pybind11;
 
 void bind_curves(py::module_& m);
@@ -19,6 +21,14 @@ PYBIND11_MODULE(_core, m) {
   m.doc() = "morphomap C++ core (use the morphomap package, not this module)";
   py::register_exception<morphomap::InvalidInput>(m, "InvalidInput", PyExc_ValueError);
   py::register_exception<morphomap::GeometryError>(m, "GeometryError", PyExc_RuntimeError);
+  py::register_exception_translator([](std::exception_ptr thrown) {
+    try {
+      if (thrown) std::rethrow_exception(thrown);
+    } catch (const morphomap::Interrupted&) {
+      PyErr_SetNone(PyExc_KeyboardInterrupt);
+    }
+  });
+  record_main_thread();
 
   m.def("build_info", [] {
     const auto info = morphomap::build_info();

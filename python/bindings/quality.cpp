@@ -4,6 +4,8 @@
 
 #include <morphomap/quality.hpp>
 
+#include "interrupt_guard.hpp"
+
 namespace py = pybind11;
 using namespace morphomap;
 
@@ -13,6 +15,7 @@ void bind_quality(py::module_& m) {
       [](const Points2Ref& starts, const Points2Ref& ends, const Points2Ref& c1,
          const Points2Ref& c2, bool closed) {
         CurveQuality q;
+        InterruptGuard interruptible;
         {
           py::gil_scoped_release release;
           DisplacementField2 field{starts, ends, {}};

@@ -8,6 +8,10 @@
 #include <morphomap/surface_mapping.hpp>
 #include <morphomap/surface_queries.hpp>
 
+#include "methods.hpp"
+
+#include "interrupt_guard.hpp"
+
 namespace py = pybind11;
 using namespace morphomap;
 
@@ -67,26 +71,29 @@ void bind_surfaces(py::module_& m) {
   m.def(
       "map_surfaces",
       [](const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2,
-         const std::string& method, bool reverse) {
+         const std::string& method, bool reverse, double mesh_size) {
         SurfaceMappingOptions options;
         options.method = surface_method(method);
         options.reverse = reverse;
+        options.diffusion_mesh_size = mesh_size;
         DisplacementField3 field;
+        InterruptGuard interruptible;
         {
           py::gil_scoped_release release;
           field = map_surfaces(v1, f1, v2, f2, options);
         }
-        Eigen::Matrix<std::int8_t, Eigen::Dynamic, 1> codes(field.methods.size());
-        for (std::size_t i = 0; i < field.methods.size(); ++i) codes[i] = static_cast<std::int8_t>(field.methods[i]);
-        return py::make_tuple(std::move(field.starts), std::move(field.ends), std::move(codes), std::move(field.faces));
+        return py::make_tuple(std::move(field.starts), std::move(field.ends), method_codes(field.methods),
+                              std::move(field.faces));
       },
-      py::arg("v1"), py::arg("f1"), py::arg("v2"), py::arg("f2"), py::arg("method"), py::arg("reverse"));
+      py::arg("v1"), py::arg("f1"), py::arg("v2"), py::arg("f2"), py::arg("method"), py::arg("reverse"),
+      py::arg("mesh_size"));
 
   m.def(
       "surface_quality",
       [](const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, const Points3Ref& v1,
          const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2) {
         SurfaceQuality q;
+        InterruptGuard interruptible;
         {
           py::gil_scoped_release release;
           DisplacementField3 field{starts, ends, faces, {}};

@@ -7,6 +7,7 @@ uniform) and their extensions and quality measures.
 
 from ._core import GeometryError, InvalidInput
 from ._core import build_info as _build_info
+from .components import split_components
 from .crossings import count_crossings, crossing_pairs
 from .curves import (
     arc_lengths,
@@ -45,8 +46,8 @@ __all__ = [
     "DisplacementField",
     "GeometryError",
     "InvalidInput",
-    "Similarity",
     "ShellDiffusionSolution",
+    "Similarity",
     "SurfaceHits",
     "SurfaceIndex",
     "SurfaceQuality",
@@ -72,9 +73,10 @@ __all__ = [
     "read_field",
     "resample",
     "signed_area",
+    "solve_diffusion",
+    "solve_diffusion_3d",
+    "split_components",
     "surface_normals",
     "write_curve",
     "write_field",
-    "solve_diffusion",
-    "solve_diffusion_3d",
 ]

@@ -31,6 +31,8 @@ def _demo(args) -> int:
 
 
 def _map(args, parser) -> int:
+    import numpy as np
+
     import morphomap
 
     from .io import read_curve, write_field
@@ -48,7 +50,8 @@ def _map(args, parser) -> int:
     c1, c2 = curves
     try:
         field = map_curves(c1, c2, args.method, closed=args.closed, n=args.n, reverse=args.reverse,
-                           transform=args.transform, split=args.split)
+                           transform=args.transform, split=args.split, contact_tolerance=args.contact_tolerance,
+                           mesh_size=args.mesh_size)
     except (ValueError, TypeError, morphomap.InvalidInput, morphomap.GeometryError) as error:
         parser.error(f"cannot map {args.c1} onto {args.c2} with --method {args.method}: {error}")
     q = quality(field, c1, c2, closed=args.closed)
@@ -57,15 +60,17 @@ def _map(args, parser) -> int:
         if args.plot:
             from matplotlib.figure import Figure
 
-            from .plot import plot_field
+            from .plot import plot_field, save_figure
 
             fig = Figure(figsize=(7, 7), layout="constrained")
             plot_field(field, c1, c2, ax=fig.subplots(), closed=args.closed,
                        title=f"{args.method}: QM1 {q.qm1:.4g}  QM2 {q.qm2:.4g}  QM {q.qm:.4g}")
-            fig.savefig(args.plot, dpi=100)
+            save_figure(fig, args.plot, dpi=100)
     except OSError as error:
         parser.error(f"cannot write {error.filename}: {error.strerror or error}")
-    summary = (f"{len(field)} vectors, {int(field.valid.sum())} valid, {int((~field.valid).sum())} misses; "
+    names, counts = np.unique(field.method, return_counts=True)
+    used = ", ".join(f"{name} {count}" for name, count in zip(names, counts))
+    summary = (f"{len(field)} vectors, {int(field.valid.sum())} valid, {int((~field.valid).sum())} missed ({used}); "
                f"QM1 {q.qm1:.4g}  QM2 {q.qm2:.4g}  QM {q.qm:.4g}  crossings {q.crossings}")
     where = "" if args.output == "-" else f"; field written to {args.output}"
     where += f", plot to {args.plot}" if args.plot else ""
@@ -106,13 +111,22 @@ def main(argv=None) -> int:
                          help="move C1 close to C2 first (the paper's Appendix A), then map")
     mapping.add_argument("--no-split", dest="split", action="store_false",
                          help="do not split the curves where they cross")
+    mapping.add_argument("--contact-tolerance", type=_length, default=None, metavar="D",
+                         help="curves closer than D are in contact there: split and mapped to the closest point "
+                              "(default: 1%% of the finer median point spacing)")
+    mapping.add_argument("--mesh-size", type=lambda text: _length(text, positive=True), default=None, metavar="H",
+                         help="the diffusion mesh size (default: from the gap between the curves)")
     mapping.add_argument("-o", "--output", default="-", metavar="FIELD.csv",
                          help="where to write the field (columns start_x,start_y,end_x,end_y,valid,method); "
                               "default: standard output")
     mapping.add_argument("--plot", metavar="FIELD.png", help="also draw the field into this image file")
     mapping.set_defaults(run=lambda args: _map(args, mapping))
     args = parser.parse_args(argv)
-    return args.run(args)
+    try:
+        return args.run(args)
+    except KeyboardInterrupt:
+        print("morphomap: interrupted", file=sys.stderr)
+        return 130
 
 
 def _positive(text: str) -> int:
@@ -122,6 +136,16 @@ def _positive(text: str) -> int:
         raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
     if value < 2:
         raise argparse.ArgumentTypeError(f"expected at least 2, got {value}")
+    return value
+
+
+def _length(text: str, positive: bool = False) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not (value > 0 if positive else value >= 0) or value == float("inf"):
+        raise argparse.ArgumentTypeError(f"expected a finite length {'>' if positive else '>='} 0, got {value}")
     return value
 
 

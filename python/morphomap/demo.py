@@ -98,7 +98,7 @@ def run(out="morphomap-demo", *, pairs=EXAMPLES, stream=None, plots=True) -> lis
     ``NAME/METHOD_VARIANT.csv`` (the field) and ``.png`` (its picture, unless ``plots=False``),
     ``NAME/all.png`` (the grid), and ``quality.csv`` with the table.
     """
-    from .plot import plot_field
+    from .plot import plot_field, save_figure
 
     stream = sys.stdout if stream is None else stream
     out = pathlib.Path(out)
@@ -144,7 +144,7 @@ def run(out="morphomap-demo", *, pairs=EXAMPLES, stream=None, plots=True) -> lis
                     label = f"{title}\nQM1 {_number(q.qm1)}  QM2 {_number(q.qm2)}  QM {_number(q.qm)}"
                     single, single_axes = _figure(1, 1, 6.0)
                     plot_field(field, c1, c2, ax=single_axes[0, 0], title=f"{pair}: {label}")
-                    single.savefig(stem.with_suffix(".png"), dpi=100)
+                    save_figure(single, stem.with_suffix(".png"), dpi=100)
                     written.append(stem.with_suffix(".png"))
                     plot_field(field, c1, c2, ax=axes[i, j], title=label)
         # The default: normal mapping, reverse diffusion where it crosses or misses.
@@ -161,11 +161,11 @@ def run(out="morphomap-demo", *, pairs=EXAMPLES, stream=None, plots=True) -> lis
             single, single_axes = _figure(1, 1, 6.0)
             plot_field(field, c1, c2, ax=single_axes[0, 0],
                        title=f"{pair}: auto ({used})\nQM1 {_number(q.qm1)}  QM2 {_number(q.qm2)}  QM {_number(q.qm)}")
-            single.savefig(folder / "auto.png", dpi=100)
+            save_figure(single, folder / "auto.png", dpi=100)
             written.append(folder / "auto.png")
         if plots:
             fig.suptitle(f"{pair}: C1 green, C2 blue, vectors red, crossing vectors orange, misses grey x")
-            fig.savefig(folder / "all.png", dpi=80)
+            save_figure(fig, folder / "all.png", dpi=80)
             written.append(folder / "all.png")
     table = format_table(rows)
     print(table, file=stream)

@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-import numbers
 from dataclasses import dataclass
 
 import numpy as np
 
 from . import _core
-from ._validate import as_flag, as_points
+from ._validate import as_flag, as_length, as_points
 
 
 @dataclass(frozen=True)
@@ -35,24 +34,14 @@ class DiffusionSolution:
     seconds: dict
 
 
-def _length(value, name, default):
-    if value is None:
-        return default
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise TypeError(f"{name}: expected a number, got {type(value).__name__}")
-    value = float(value)
-    if not np.isfinite(value) or value <= 0:
-        raise ValueError(f"{name}: must be a finite number > 0, got {value}")
-    return value
-
-
 def solve_diffusion(c1, c2, *, closed=True, mesh_size=None, mesh_fraction=0.02, streamlines=False):
     """Solve Laplace's equation between C1 (c = 1) and C2 (c = 0) and trace the streamlines.
 
     The region: closed curves nested (an annulus) or crossing (each lobe of the symmetric
     difference); open curves joined start to start and end to end by straight edges without flux.
     The mesh: a triangular lattice (equilateral triangles) of spacing ``mesh_size`` (default:
-    ``mesh_fraction`` times the mean gap, twice the region's area over its boundary length) inside
+    ``mesh_fraction`` times the mean gap, twice the region's area over its boundary length, but no
+    finer than a lattice of max(40000, 20 per curve point) vertices over the region would be) inside
     the region, joined to both curves, whose points are all vertices, by CGAL's constrained
     Delaunay mesher (smallest angle about 20.7 degrees, graded from the curves' point spacing).
     Laplace's equation is solved with P1 elements; the gradient is recovered at the vertices and
@@ -64,6 +53,6 @@ def solve_diffusion(c1, c2, *, closed=True, mesh_size=None, mesh_fraction=0.02, 
     """
     vertices, triangles, potential, ends, lines, seconds = _core.solve_diffusion(
         as_points(c1, "c1"), as_points(c2, "c2"), as_flag(closed, "closed"),
-        _length(mesh_size, "mesh_size", 0.0), _length(mesh_fraction, "mesh_fraction", 0.02),
+        as_length(mesh_size, "mesh_size", 0.0), as_length(mesh_fraction, "mesh_fraction", 0.02),
         as_flag(streamlines, "streamlines"))
     return DiffusionSolution(vertices, triangles, potential, ends, list(lines), dict(seconds))

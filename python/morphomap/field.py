@@ -6,8 +6,9 @@ import numpy as np
 
 from ._validate import as_points
 
-#: Names of the basic algorithms, indexed by the codes the C++ core uses.
-METHOD_NAMES = ("minimal_distance", "normal", "diffusion", "uniform")
+#: Names of the basic algorithms; ``reverse_`` ones ran from C2 to C1 and were flipped.
+BASIC_METHODS = ("minimal_distance", "normal", "diffusion", "uniform")
+METHOD_NAMES = BASIC_METHODS + tuple(f"reverse_{name}" for name in BASIC_METHODS)
 
 
 def _frozen(array: np.ndarray) -> np.ndarray:
@@ -22,16 +23,17 @@ class DisplacementField:
     Attributes
     ----------
     starts, ends : (M, d) float
-        ``d`` is 2 or 3. ``ends`` rows are NaN where the algorithm found no target for that start
-        point (a normal that never meets C2, say); a reverse mapping's missing rows are NaN in
-        ``starts`` too.
+        ``d`` is 2 or 3. A row whose algorithm found nothing keeps the point it came from: NaN in
+        ``ends`` where a start point found no target (a normal that never meets C2, say), NaN in
+        ``starts`` where a reverse vector's point of C2 found nothing on C1.
     vectors : (M, d) float
         ``ends - starts``.
     valid : (M,) bool
         False where the row is NaN.
     method : (M,) str
         The basic algorithm that produced each vector (``"minimal_distance"``, ``"normal"``,
-        ``"diffusion"``, ``"uniform"``); meaningful for ``method="auto"``.
+        ``"diffusion"``, ``"uniform"``), with ``"reverse_"`` before it where the vector was found
+        from C2 back to C1 (the paper's reverse mapping, e.g. ``"reverse_diffusion"``).
     faces : (F, 3) int64 or None
         3D only: the connectivity of the start points.
 
@@ -63,8 +65,9 @@ class DisplacementField:
         self._faces = None if faces is None else _frozen(np.asarray(faces, dtype=np.int64))
 
     @classmethod
-    def _from_core(cls, starts, ends, codes, faces=None):
-        return cls(starts, ends, np.asarray(METHOD_NAMES)[np.asarray(codes, dtype=np.int64)], faces)
+    def _from_core(cls, starts, ends, methods, faces=None):
+        codes, names = methods  # the core's codes and its table of their names
+        return cls(starts, ends, np.asarray(names)[np.asarray(codes, dtype=np.int64)], faces)
 
     @property
     def starts(self) -> np.ndarray:
@@ -100,4 +103,6 @@ class DisplacementField:
     def __repr__(self) -> str:
         names, counts = np.unique(self._method, return_counts=True)
         made = ", ".join(f"{n}: {c}" for n, c in zip(names, counts))
-        return f"DisplacementField({len(self)} vectors in {self.dim}D, {int(self.valid.sum())} valid; {made})"
+        missed = len(self) - int(self.valid.sum())
+        return (f"DisplacementField({len(self)} vectors in {self.dim}D, {len(self) - missed} valid, "
+                f"{missed} missed; {made})")

@@ -18,6 +18,7 @@ from importlib import resources
 
 import numpy as np
 
+from ._atomic import atomic_text
 from ._validate import as_points
 from .field import DisplacementField
 
@@ -101,10 +102,11 @@ def read_curve(path) -> np.ndarray:
 
 
 def _output(path):
-    """An open text file for ``path``, or ``path`` itself when it is already writable (not closed)."""
+    """An open text file for ``path`` (written atomically), or ``path`` itself when it is already
+    writable (not closed)."""
     if hasattr(path, "write"):
         return contextlib.nullcontext(path)
-    return open(os.fspath(path), "w", encoding="utf-8", newline="")
+    return atomic_text(path)
 
 
 def write_curve(path, points, *, header=True) -> None:

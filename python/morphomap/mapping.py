@@ -7,7 +7,7 @@ import numbers
 import numpy as np
 
 from . import _core
-from ._validate import as_choice, as_count, as_flag, as_point, as_points
+from ._validate import as_choice, as_count, as_flag, as_length, as_point, as_points
 from .field import DisplacementField
 
 CURVE_METHODS = ("auto", "minimal_distance", "normal", "diffusion", "uniform")
@@ -23,8 +23,19 @@ def _threshold(value) -> float:
     return float(value)
 
 
+def _tolerance(value) -> float:
+    if value is None:
+        return -1.0  # the core's default
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise TypeError(f"contact_tolerance: expected a number, got {type(value).__name__}")
+    if not np.isfinite(value) or value < 0:
+        raise ValueError(f"contact_tolerance: must be a finite length >= 0, got {value}")
+    return float(value)
+
+
 def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, transform=False,
-               split=True, anchor=None, density_threshold=None) -> DisplacementField:
+               split=True, anchor=None, density_threshold=None, contact_tolerance=None,
+               mesh_size=None, mesh_fraction=0.02) -> DisplacementField:
     """Map curve ``c1`` (time t) onto curve ``c2`` (time t + dt).
 
     Parameters
@@ -44,10 +55,17 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
         see :func:`solve_diffusion`) from each start point to C2.
         ``"auto"`` (the default; the paper's Algorithm 1): split at intersections, normal mapping
         on each pair of segments, and reverse diffusion for a pair where normal mapping gives
-        crossings or misses. ``field.method`` tells which algorithm made each vector.
+        crossings or misses. Where reverse diffusion fails on a pair (its region cannot be
+        meshed, streamlines stall), ``auto`` still answers: diffusion (also crossing-free), else
+        the normal mapping if it missed nothing (crossings and all), else minimal distance.
+        ``field.method`` tells which algorithm made each vector (``"reverse_diffusion"`` and
+        so on for vectors found from C2).
     n : int, optional
         Resample both curves to ``n`` equally spaced points first (linear, the paper's
         preprocessing); by default the given points of the source curve are the start points.
+        The points found on the resampled curves are then put onto ``c1`` and ``c2`` as given
+        (their closest points: the resampled polylines cut the corners), so that
+        ``quality(field, c1, c2)`` measures the field on the curves you passed.
     reverse : bool
         Map C2 -> C1 with the chosen algorithm and flip the vectors: starts lie on C1, ends on
         C2, in the order of C2's points.
@@ -68,6 +86,18 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
         spacing along C1, i.e. start points per gap — reverse minimal distance is tried before
         normal mapping (reverse diffusion still replaces it if it crosses or misses). The paper
         gives no number; 5 (five points per gap) is a reasonable start.
+    contact_tolerance : float, optional
+        Where the curves touch or run together closer than this — consecutive frames segmented
+        on one pixel grid share whole stretches where the tissue did not move — they are split
+        there, as at an intersection (whatever ``split`` says), and the start points on the
+        stretch map to their closest point on C2 (``field.method`` says ``"minimal_distance"``).
+        Default: 1% of the finer of the two curves' median point spacings; 0: exact contact only.
+    mesh_size, mesh_fraction : float, optional
+        The diffusion mesh (also within ``"auto"``), as in :func:`solve_diffusion`.
+
+    Both curves must be simple: one loop each, not meeting itself (``ValueError`` naming the
+    curve otherwise, with the count; :func:`split_components` separates the loops of several
+    objects joined into one array).
 
     Returns
     -------
@@ -81,5 +111,6 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
     starts, ends, codes = _core.map_curves(
         as_points(c1, "c1"), as_points(c2, "c2"), method, closed, count,
         as_flag(reverse, "reverse"), as_flag(transform, "transform"), as_flag(split, "split"), anchor,
-        _threshold(density_threshold))
+        _threshold(density_threshold), _tolerance(contact_tolerance),
+        as_length(mesh_size, "mesh_size", 0.0), as_length(mesh_fraction, "mesh_fraction", 0.02))
     return DisplacementField._from_core(starts, ends, codes)

@@ -7,6 +7,7 @@ import sys
 
 import numpy as np
 
+from ._atomic import atomic_path
 from ._validate import as_flag, as_points
 from .crossings import crossing_pairs
 from .field import DisplacementField
@@ -109,3 +110,9 @@ def plot_field(field, c1, c2, ax=None, *, closed=True, title=None):
     if title is not None:
         ax.set_title(title)
     return ax
+
+
+def save_figure(figure, path, **options) -> None:
+    """``figure.savefig(path, **options)``, written atomically (the format from the suffix)."""
+    with atomic_path(path) as temporary:
+        figure.savefig(temporary, **options)

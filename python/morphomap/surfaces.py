@@ -7,7 +7,7 @@ from typing import NamedTuple
 import numpy as np
 
 from . import _core
-from ._validate import as_choice, as_flag, as_points
+from ._validate import as_choice, as_flag, as_length, as_points
 from .field import DisplacementField
 
 SURFACE_METHODS = ("minimal_distance", "normal", "diffusion", "auto")
@@ -108,7 +108,7 @@ def surface_normals(vertices, faces) -> np.ndarray:
     return _core.vertex_normals(vertices, as_faces(faces, "faces", len(vertices)))
 
 
-def map_surfaces(s1, s2, method="normal", *, reverse=False) -> DisplacementField:
+def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None) -> DisplacementField:
     """Map closed surface ``s1`` (time t) onto closed surface ``s2`` (time t + dt).
 
     Parameters
@@ -129,6 +129,9 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False) -> DisplacementField
     reverse : bool
         Map S2 -> S1 with the chosen algorithm and flip the vectors: starts lie on S1, ends on S2,
         in the order of S2's vertices, and ``field.faces`` are S2's faces.
+    mesh_size : float, optional
+        The tetrahedral mesh of diffusion mapping (also within ``"auto"``), as in
+        :func:`solve_diffusion_3d`.
 
     Returns
     -------
@@ -139,5 +142,6 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False) -> DisplacementField
     reverse = as_flag(reverse, "reverse")
     v1, f1 = as_surface(s1, "s1")
     v2, f2 = as_surface(s2, "s2")
-    starts, ends, codes, faces = _core.map_surfaces(v1, f1, v2, f2, method, reverse)
+    starts, ends, codes, faces = _core.map_surfaces(v1, f1, v2, f2, method, reverse,
+                                                    as_length(mesh_size, "mesh_size", 0.0))
     return DisplacementField._from_core(starts, ends, codes, faces)

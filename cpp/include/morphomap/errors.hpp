@@ -17,4 +17,10 @@ class GeometryError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// The call stopped early because request_interrupt() was called (see interrupt.hpp).
+class Interrupted : public std::runtime_error {
+ public:
+  Interrupted() : std::runtime_error("interrupted") {}
+};
+
 }  // namespace morphomap

@@ -8,11 +8,25 @@
 
 namespace morphomap {
 
-// The basic algorithm that produced a vector.
-enum class Method : std::int8_t { minimal_distance = 0, normal = 1, diffusion = 2, uniform = 3 };
+// The basic algorithm that produced a vector, and whether it ran backwards (from C2 to C1, the
+// paper's reverse mapping, then flipped).
+enum class Method : std::int8_t {
+  minimal_distance = 0,
+  normal = 1,
+  diffusion = 2,
+  uniform = 3,
+  reverse_minimal_distance = 4,
+  reverse_normal = 5,
+  reverse_diffusion = 6,
+  reverse_uniform = 7,
+};
+constexpr int kMethodCount = 8;
 
-// "minimal_distance", "normal", "diffusion" or "uniform".
+// "minimal_distance", "normal", "diffusion", "uniform", and "reverse_" before each.
 std::string method_name(Method method);
+
+// The same algorithm run the other way: normal <-> reverse_normal, and so on.
+Method reversed(Method method);
 
 // Vectors starts[i] -> ends[i] from C1 to C2, in the order of the points of the curve the
 // algorithm mapped from. A row whose algorithm found no target is NaN in ends (and, for a

@@ -12,7 +12,8 @@ struct DiffusionOptions {
   // Mesh size: the lattice spacing is 0.97 times it, and no edge along the curves is longer; in
   // the lattice, a triangle next to a point the mesher added may reach the lattice triangles'
   // circumdiameter (1.12 times it). 0 picks mesh_fraction * the mean gap between the curves
-  // (twice the region's area over its boundary length). Near the curves the mesh is graded from
+  // (twice the region's area over its boundary length), but no finer than a lattice of
+  // max(40000, 20 * the number of curve points) vertices over the region would be. Near the curves the mesh is graded from
   // their point spacing and refined where the gap is narrow, whatever this bound.
   double mesh_size = 0.0;
   double mesh_fraction = 0.02;

@@ -1,6 +1,7 @@
 #pragma once
 // Displacement fields between two curves: the paper's basic algorithms and extensions.
 #include <morphomap/field.hpp>
+#include <morphomap/laplace.hpp>
 #include <morphomap/types.hpp>
 
 #include <optional>
@@ -24,8 +25,22 @@ struct CurveMappingOptions {
   std::optional<Vec2> anchor;  // uniform mapping of closed curves that do not cross: a point
                                // of C1 (its nearest curve point) that maps onto its nearest
                                // point of C2
+  // Where the curves touch or run together closer than this (a stretch of source points within
+  // it of the target, or a single touching point), they are split there as at a crossing, and
+  // the points on the stretch map to their closest point of the target; whatever `split` says.
+  // < 0: 1% of the finer of the two curves' median segment lengths; 0: exact contact only.
+  double contact_tolerance = -1.0;
+  DiffusionOptions diffusion;  // the mesh of diffusion mapping (also within "auto")
 };
 
+// Both curves must be simple (no self-intersection, one loop) and, when closed, enclose an area:
+// InvalidInput naming "c1" or "c2" otherwise. "auto" answers wherever a basic algorithm does:
+// where reverse diffusion fails on a piece it falls back to diffusion, then to normal mapping
+// (if that missed nothing), then to minimal distance; methods names what each vector used, with
+// reverse_ variants for vectors found from C2 (reverse = true flips every name). A vector that
+// found nothing keeps the point it came from: NaN ends on forward vectors, NaN starts on reverse
+// ones. With n > 0 the start and end points are put onto c1 and c2 as given (the resampled
+// curves cut their corners).
 DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2,
                               const CurveMappingOptions& options = {});
 

@@ -6,6 +6,8 @@
 #include <morphomap/curve_queries.hpp>
 #include <morphomap/errors.hpp>
 #include <morphomap/field.hpp>
+#include <morphomap/interrupt.hpp>
+#include <morphomap/laplace.hpp>
 #include <morphomap/laplace3d.hpp>
 #include <morphomap/mapping.hpp>
 #include <morphomap/quality.hpp>

@@ -15,7 +15,9 @@ struct SurfaceMappingOptions {
   //   ends are put onto their closest point of the target (the tetrahedral mesh only
   //   approximates it).
   // automatic: normal mapping; if it misses anywhere or folds a triangle (count_folds), reverse
-  //   diffusion for the whole surface instead (methods tells which).
+  //   diffusion for the whole surface instead (methods tells which); where that fails (the
+  //   region cannot be meshed), diffusion, then the normal mapping if it missed nothing, then
+  //   minimal distance.
   // uniform has no 3D form: InvalidInput.
   MapMethod method = MapMethod::normal;
   bool reverse = false;  // map S2 -> S1 and flip: starts on S1, ends on S2, rows and faces of S2
@@ -24,7 +26,8 @@ struct SurfaceMappingOptions {
 
 // Both surfaces must pass check_closed_surface (named "s1" and "s2"). Start points are the
 // vertices of the source surface (S1, or S2 when reversed), in its order; field.faces are its
-// faces. A reverse vector that finds no start point on S1 is NaN in starts and ends.
+// faces. A vector that found nothing keeps its known point: NaN ends on forward vectors, NaN
+// starts on reverse ones (methods then name reverse_ variants).
 DisplacementField3 map_surfaces(const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2,
                                 const FacesRef& f2, const SurfaceMappingOptions& options = {});
 

@@ -42,8 +42,8 @@ SurfaceHits line_intersections(const Points3Ref& origins, const Points3Ref& dire
 Points3 vertex_normals(const Points3Ref& vertices, const FacesRef& faces);
 
 // Throws InvalidInput naming `name` unless the surface is closed, edge-manifold and consistently
-// oriented, with finite coordinates, valid indices and no zero-area face; returns its signed volume
-// (positive when the normals point outwards).
+// oriented, one connected component, with finite coordinates, valid indices, every vertex used and
+// no zero-area face; returns its signed volume (positive when the normals point outwards).
 double check_closed_surface(const Points3Ref& vertices, const FacesRef& faces, const char* name);
 
 }  // namespace morphomap

@@ -1,0 +1,244 @@
+"""Regression tests of the real-segmentations issue: frames that touch, coincide or come in pieces."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+from skimage import measure
+
+import morphomap as mm
+from conftest import circle, ellipse
+
+CASES = Path(__file__).resolve().parents[1].parent / "shared" / "cases"
+
+
+def shared_frames():
+    if not (CASES / "frame2.csv").exists():
+        pytest.skip("the shared cases are not beside the project")
+    return mm.read_curve(CASES / "frame2.csv"), mm.read_curve(CASES / "frame3.csv")
+
+
+def distance_to(points, curve):
+    return mm.closest_points(points, curve).distances
+
+
+@pytest.mark.parametrize("method", ["auto", "diffusion"])
+@pytest.mark.parametrize("reverse", [False, True])
+def test_the_shared_frames_map_without_crossings(method, reverse):
+    # A tenth of these two contours did not move: they share pixel stretches (this segfaulted).
+    c1, c2 = shared_frames()
+    field = mm.map_curves(c1, c2, method, reverse=reverse)
+    assert field.valid.all()
+    q = mm.quality(field, c1, c2)
+    assert q.crossings == 0
+    size = np.ptp(c2, axis=0).max()
+    assert distance_to(field.ends, c2).max() < 1e-9 * size
+    assert distance_to(field.starts, c1).max() < 1e-9 * size
+    # The shared stretches are contact: their points stay (the longest vector there is tiny).
+    on_stretch = field.method == ("reverse_minimal_distance" if reverse else "minimal_distance")
+    assert on_stretch.sum() > 0.05 * len(c1)
+    assert np.linalg.norm(field.vectors[on_stretch], axis=1).max() < 0.05 * np.median(
+        np.linalg.norm(np.diff(c1, axis=0), axis=1))
+
+
+def masks_sharing_a_stretch(spacing=(0.7, 1.0)):
+    """Two blobs on one pixel grid, the second grown on its right half only, contoured."""
+    rows, cols = np.mgrid[0:120, 0:120]
+    first = (rows - 60) ** 2 / 30 ** 2 + (cols - 60) ** 2 / 26 ** 2 <= 1
+    second = first | (((rows - 60) ** 2 / 34 ** 2 + (cols - 60) ** 2 / 36 ** 2 <= 1) & (cols > 64))
+    curves = []
+    for mask in (first, second):
+        contour = max(measure.find_contours(mask.astype(float), 0.5), key=len)[:-1]
+        curves.append(np.column_stack([contour[:, 1] * spacing[1], contour[:, 0] * spacing[0]]))
+    return curves
+
+
+@pytest.mark.parametrize("method", ["auto", "normal", "minimal_distance", "diffusion", "uniform"])
+def test_a_shared_stretch_is_split_and_maps_onto_itself(method):
+    c1, c2 = masks_sharing_a_stretch()
+    field = mm.map_curves(c1, c2, method)
+    assert field.valid.all()
+    shared = distance_to(c1, c2) == 0.0  # the left half did not move
+    assert shared.sum() > 0.3 * len(c1)
+    # Every start on the shared stretch maps onto itself.
+    rows = np.flatnonzero(distance_to(field.starts, c2) == 0.0)
+    np.testing.assert_allclose(field.ends[rows], field.starts[rows], atol=1e-12)
+    if method in ("auto", "diffusion", "uniform"):
+        assert mm.quality(field, c1, c2).crossings == 0
+
+
+def test_contact_tolerance_is_checked_and_zero_means_exact_contact():
+    c1, c2 = masks_sharing_a_stretch()
+    exact = mm.map_curves(c1, c2, "diffusion", contact_tolerance=0.0)
+    assert exact.valid.all() and mm.quality(exact, c1, c2).crossings == 0
+    with pytest.raises(ValueError, match="contact_tolerance"):
+        mm.map_curves(c1, c2, contact_tolerance=-1.0)
+    with pytest.raises(TypeError, match="contact_tolerance"):
+        mm.map_curves(c1, c2, contact_tolerance="small")
+
+
+def test_touching_at_one_point_is_a_split():
+    # A circle inside another, touching it at (1, 0) from the inside.
+    c1 = circle(200, 0.5, centre=(0.5, 0.0))
+    c2 = circle(200, 1.0)
+    for method in ("auto", "diffusion"):
+        field = mm.map_curves(c1, c2, method)
+        assert field.valid.all() and mm.quality(field, c1, c2).crossings == 0
+        assert distance_to(field.ends, c2).max() < 1e-9
+
+
+def test_resampled_fields_lie_on_the_given_curves():
+    c1, c2 = mm.load_example("kidney")
+    for reverse in (False, True):
+        field = mm.map_curves(c1, c2, n=300, reverse=reverse)
+        assert distance_to(field.starts[field.valid], c1).max() < 1e-9
+        assert distance_to(field.ends[field.valid], c2).max() < 1e-9
+        mm.quality(field, c1, c2)  # accepted
+
+
+def test_the_cli_writes_a_resampled_field(tmp_path):
+    c1, c2 = mm.load_example("kidney")
+    mm.write_curve(tmp_path / "c1.csv", c1)
+    mm.write_curve(tmp_path / "c2.csv", c2)
+    run = subprocess.run([sys.executable, "-m", "morphomap", "map", tmp_path / "c1.csv", tmp_path / "c2.csv",
+                          "--n", "250", "-o", tmp_path / "f.csv"], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr
+    assert len(mm.read_field(tmp_path / "f.csv")) >= 250
+    assert "missed" in run.stderr
+
+
+@pytest.mark.parametrize("method", ["auto", "normal", "minimal_distance", "diffusion", "uniform"])
+def test_two_objects_in_one_curve_are_refused_with_the_count(method):
+    a = np.vstack([circle(50, 1.0), circle(1, 1.0)])  # a contour repeats its first point
+    b = np.vstack([circle(40, 0.3, centre=(3, 0)), circle(1, 0.3, centre=(3, 0))])
+    both = np.vstack([a, b])
+    with pytest.raises(ValueError, match=r"c1: the points form 2 loops"):
+        mm.map_curves(both, circle(80, 2.0), method)
+    parts = mm.split_components(both)
+    assert [len(p) for p in parts] == [50, 40]
+    mm.map_curves(parts[0], circle(80, 2.0), method)
+
+
+@pytest.mark.parametrize("method", ["auto", "normal", "minimal_distance", "diffusion", "uniform"])
+def test_self_intersecting_curves_are_refused_for_every_method(method):
+    t = 2 * np.pi * np.arange(200) / 200
+    eight = np.column_stack([np.sin(t), np.sin(t) * np.cos(t)])  # encloses zero signed area
+    with pytest.raises(ValueError, match=r"c1: the curve intersects itself: 1 pair"):
+        mm.map_curves(eight, circle(100, 3.0), method)
+    with pytest.raises(ValueError, match=r"c2: the curve intersects itself"):
+        mm.map_curves(circle(100, 3.0), eight, method)
+
+
+def test_misses_keep_their_known_point():
+    c1, c2 = circle(200, 0.3, centre=(1.5, 0.0)), circle(200, 3.0)
+    field = mm.map_curves(c1, c2, "normal", reverse=True)  # most normals of the big circle miss
+    missed = ~field.valid
+    assert missed.any()
+    assert np.isfinite(field.ends[missed]).all() and np.isnan(field.starts[missed]).all()
+    assert f"{missed.sum()} missed" in repr(field)
+
+
+def icosphere(radius=1.0, centre=(0.0, 0.0, 0.0), subdivisions=3):
+    mesh = trimesh.creation.icosphere(subdivisions, radius=radius)
+    mesh.apply_translation(centre)
+    return mesh
+
+
+@pytest.mark.parametrize("method", ["normal", "minimal_distance", "diffusion", "auto"])
+def test_debris_in_a_surface_is_refused_with_the_count(method):
+    organ = trimesh.util.concatenate([icosphere(10.0), icosphere(1.0, (20.0, 0, 0), 1)])
+    with pytest.raises(ValueError, match=r"s1: the surface has 2 separate components \(1280, 80 faces\)"):
+        mm.map_surfaces(organ, icosphere(12.0), method)
+    parts = mm.split_components(organ)
+    assert [len(p.faces) for p in parts] == [1280, 80]
+    mm.map_surfaces(parts[0], icosphere(12.0), method)
+
+
+def test_inward_and_unused_vertex_surfaces_are_refused():
+    inward = icosphere(1.0)
+    inward.invert()
+    with pytest.raises(ValueError, match="s1: the faces are oriented inwards"):
+        mm.map_surfaces(inward, icosphere(2.0), "normal")
+    with pytest.raises(ValueError, match="s2: the faces are oriented inwards"):
+        mm.quality(mm.map_surfaces(icosphere(1.0), icosphere(2.0)), icosphere(1.0), inward)
+    sphere = icosphere(1.0)
+    extra = (np.vstack([sphere.vertices, [[5.0, 5.0, 5.0]]]), sphere.faces)
+    with pytest.raises(ValueError, match="s1: vertex 642 .* is used by no face"):
+        mm.map_surfaces(extra, icosphere(2.0), "normal")
+
+
+def voxel_surfaces():
+    """Two marching-cubes surfaces on one voxel grid: the second grew a bud on one side only, so
+    the far side's faces are shared exactly."""
+    z, y, x = np.mgrid[0:40, 0:40, 0:40]
+    first = (x - 20) ** 2 + (y - 20) ** 2 + (z - 20) ** 2 <= 11 ** 2
+    second = first | ((x - 29) ** 2 + (y - 20) ** 2 + (z - 20) ** 2 <= 6 ** 2)
+    meshes = []
+    for volume in (first, second):
+        vertices, faces, _, _ = measure.marching_cubes(np.pad(volume, 1).astype(float), 0.5,
+                                                       spacing=(2.0, 1.0, 1.0))
+        mesh = trimesh.Trimesh(vertices[:, ::-1], faces, process=True)
+        if mesh.volume < 0:
+            mesh.invert()
+        meshes.append(mesh)
+    return meshes
+
+
+def test_surfaces_sharing_faces_still_map_with_auto():
+    s1, s2 = voxel_surfaces()
+    shared = mm.SurfaceIndex(s2.vertices, s2.faces).closest_points(s1.vertices).distances == 0
+    assert shared.mean() > 0.3
+    field = mm.map_surfaces(s1, s2, "auto")
+    assert field.valid.all()
+    on_s2 = mm.SurfaceIndex(s2.vertices, s2.faces).closest_points(field.ends).distances
+    assert on_s2.max() < 1e-6 * np.ptp(s2.vertices, axis=0).max()
+
+
+def test_ctrl_c_stops_a_long_mapping_within_a_second(tmp_path):
+    if os.name != "posix":
+        pytest.skip("signals")
+    # Diffusion at 2e5 points per curve: about 7 s meshing, 2 s solving (the one phase that
+    # cannot stop early: a sparse factorisation), 5 s tracing.
+    c1, c2 = ellipse(200_000, 1.0, 0.6), ellipse(200_000, 2.0, 1.6)
+    mm.write_curve(tmp_path / "c1.csv", c1)
+    mm.write_curve(tmp_path / "c2.csv", c2)
+    (tmp_path / "f.csv").write_text("previous\n")
+    process = subprocess.Popen([sys.executable, "-m", "morphomap", "map", tmp_path / "c1.csv", tmp_path / "c2.csv",
+                                "--method", "diffusion", "-o", tmp_path / "f.csv"],
+                               stderr=subprocess.PIPE, text=True)
+    time.sleep(4.0)  # reading the curves takes a second or two; then it is meshing
+    assert process.poll() is None, "finished before the interrupt: make the case bigger"
+    sent = time.monotonic()
+    process.send_signal(signal.SIGINT)
+    _, stderr = process.communicate(timeout=30)
+    took = time.monotonic() - sent
+    assert process.returncode == 130
+    assert stderr.strip() == "morphomap: interrupted"
+    assert took < 1.5, took
+    assert (tmp_path / "f.csv").read_text() == "previous\n"  # the old field is still there
+
+
+def test_an_interrupted_write_leaves_the_old_file(tmp_path):
+    target = tmp_path / "field.csv"
+    target.write_text("previous\n")
+    field = mm.map_curves(circle(50, 1.0), circle(50, 2.0), "normal")
+
+    class Broken:
+        def __iter__(self):
+            raise KeyboardInterrupt
+
+    from morphomap._atomic import atomic_text
+    with pytest.raises(KeyboardInterrupt):
+        with atomic_text(target) as handle:
+            handle.write("start_x,start_y\n")
+            list(Broken())
+    assert target.read_text() == "previous\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["field.csv"]
+    mm.write_field(target, field)
+    assert len(mm.read_field(target)) == 50
