@@ -158,12 +158,24 @@ class Tracer {
     Vec2 x = point(start);
     record(x);
     Index steps_here = 0, last_triangle = -1;  // a streamline that stalls in one triangle is lost
+    // c falls along a streamline: one that has not gone below its lowest c for kStallSteps steps
+    // circles or shuttles between triangles (where the recovered flow turns back), and is lost.
+    double lowest = c_[start];
+    Index since_lowest = 0;
     for (Index step = 0; step < step_limit_; ++step) {
       if (step % 1024 == 0) detail::check_interrupt();
       if (t >= 0 && t == last_triangle) {
         if (++steps_here > kStallSteps) return lost;
       } else {
         steps_here = 0, last_triangle = t;
+      }
+      if (t >= 0 && step % 16 == 0) {
+        const double here = c_at(t, x);
+        if (here < lowest - 1e-12) {
+          lowest = here, since_lowest = 0;
+        } else if ((since_lowest += 16) > kStallSteps) {
+          return lost;
+        }
       }
       if (vertex >= 0) {
         if (kind_[vertex] == target_vertex && vertex != start) return point(vertex);
@@ -401,6 +413,7 @@ DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2
   const CurveIndex on_source(source, closed), on_target(target, closed);
   const double scale = (mesh.vertices.colwise().maxCoeff() - mesh.vertices.colwise().minCoeff()).norm();
   for (Index v = 0; v < nv; ++v) {
+    if (v % 65536 == 0) detail::check_interrupt();
     const Index input = mesh.input[v];
     if (input >= 0) {
       kind[v] = input < ns ? source_vertex : target_vertex;

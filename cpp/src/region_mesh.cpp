@@ -121,6 +121,7 @@ void mark_odd_nesting(Cdt& cdt) {
     component.push(start);
     level[start] = depth;
     while (!component.empty()) {
+      if (level.size() % 65536 == 0) check_interrupt();
       const Cdt::Face_handle f = component.front();
       component.pop();
       for (int i = 0; i < 3; ++i) {
@@ -220,6 +221,7 @@ std::vector<Point> layer_points(const Cdt& cdt, const std::vector<Points2>& loop
   for (const Points2& loop : loops) {
     const Index n = loop.rows();
     for (Index i = 0; i < n; ++i) {
+      if (i % 4096 == 0) check_interrupt();
       const Eigen::RowVector2d before = loop.row((i + n - 1) % n), here = loop.row(i), after = loop.row((i + 1) % n);
       const Eigen::RowVector2d chord = after - before;
       const double spacing = 0.5 * ((here - before).norm() + (after - here).norm()), length = chord.norm();
@@ -283,6 +285,7 @@ RegionMesh mesh_region(const std::vector<Points2>& loops, double max_edge) {
     for (const Points2& loop : loops) {
       const Index n = loop.rows();
       for (Index i = 0; i < n; ++i) {
+        if (i % 4096 == 0) check_interrupt();
         const auto a = handles[first + i], b = handles[first + (i + 1) % n];
         if (a == b) continue;
         // Edges longer than the mesh size are split evenly beforehand, as the mesher would.
@@ -341,6 +344,7 @@ RegionMesh mesh_region(const std::vector<Points2>& loops, double max_edge) {
   std::unordered_map<Cdt::Face_handle, Index> face_index;
   for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
     if (!f->is_in_domain()) continue;
+    if (triangle_count % 65536 == 0) check_interrupt();
     face_index[f] = triangle_count++;
     for (int i = 0; i < 3; ++i) {
       if (f->vertex(i)->info().index < 0) f->vertex(i)->info().index = vertex_count++;

@@ -4,6 +4,8 @@
 // whose closed bounding boxes overlap.
 #include <morphomap/types.hpp>
 
+#include "interrupt_check.hpp"
+
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/box_intersection_d.h>
 #include <tbb/parallel_for.h>
@@ -73,6 +75,7 @@ class PairTester {
   void add(Index i, Index j) {
     batch_.emplace_back(i, j);
     if (batch_.size() == batch_size) flush();
+    if ((batch_.size() & 0xffff) == 0) check_interrupt();
   }
   Index finish() {
     flush();
