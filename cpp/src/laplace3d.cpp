@@ -31,6 +31,7 @@ namespace {
 using Vec3 = Eigen::Vector3d;
 using Vec4 = Eigen::Vector4d;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kSourceFraction = 0.02;
 using detail::free_vertex;
 using detail::source_vertex;
 using detail::target_vertex;
@@ -354,7 +355,11 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
   const double gap = volume / (0.5 * (source.area + target.area));
   detail::ShellMeshCriteria criteria;
   criteria.cell_size = options.mesh_size > 0.0 ? options.mesh_size : 0.25 * gap;
-  criteria.source_size = std::min(source.mean_edge, criteria.cell_size);
+  // Near the source, where the streamlines start, the elements stay within a fraction of the
+  // source's size however coarse its triangles are (the end error follows the element size
+  // there: concentric spheres r = 1 -> 4 with 642 vertices gave RMS 0.018 at the triangles' size).
+  const double source_diagonal = (source_vertices.colwise().maxCoeff() - source_vertices.colwise().minCoeff()).norm();
+  criteria.source_size = std::min({source.mean_edge, criteria.cell_size, kSourceFraction * source_diagonal});
   criteria.target_size = std::min(target.mean_edge, criteria.cell_size);
   criteria.grading = 0.1;
   criteria.exude = true;
