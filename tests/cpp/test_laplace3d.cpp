@@ -7,6 +7,7 @@
 #include <Eigen/LU>
 
 #include "check.hpp"
+#include "surfaces.hpp"
 
 #include <algorithm>
 #include <array>
@@ -23,61 +24,12 @@ using morphomap::Points3;
 using morphomap::ShellDiffusionOptions;
 using morphomap::solve_diffusion_3d;
 
+using morphomap_test::flipped;
+using morphomap_test::icosphere;
+using morphomap_test::scaled;
+using morphomap_test::Surface;
+
 namespace {
-
-struct Surface {
-  Points3 vertices;
-  Faces faces;
-};
-
-// Unit icosphere: the icosahedron with each triangle split in four `levels` times, outwards.
-Surface icosphere(int levels) {
-  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Eigen::Vector3d> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                                    {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-  std::vector<std::array<Index, 3>> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-                                         {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                                         {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-                                         {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
-  for (auto& p : v) p.normalize();
-  for (int level = 0; level < levels; ++level) {
-    std::map<std::pair<Index, Index>, Index> middle;
-    auto mid = [&](Index a, Index b) {
-      const auto key = std::minmax(a, b);
-      const auto found = middle.find(key);
-      if (found != middle.end()) return found->second;
-      v.push_back((v[a] + v[b]).normalized());
-      return middle[key] = static_cast<Index>(v.size()) - 1;
-    };
-    std::vector<std::array<Index, 3>> next;
-    for (const auto& [a, b, c] : f) {
-      const Index ab = mid(a, b), bc = mid(b, c), ca = mid(c, a);
-      next.push_back({a, ab, ca});
-      next.push_back({b, bc, ab});
-      next.push_back({c, ca, bc});
-      next.push_back({ab, bc, ca});
-    }
-    f = std::move(next);
-  }
-  Surface s;
-  s.vertices.resize(static_cast<Index>(v.size()), 3);
-  for (std::size_t i = 0; i < v.size(); ++i) s.vertices.row(static_cast<Index>(i)) = v[i].transpose();
-  s.faces.resize(static_cast<Index>(f.size()), 3);
-  for (std::size_t i = 0; i < f.size(); ++i) s.faces.row(static_cast<Index>(i)) << f[i][0], f[i][1], f[i][2];
-  return s;
-}
-
-Surface scaled(Surface s, double x, double y, double z) {
-  s.vertices.col(0) *= x;
-  s.vertices.col(1) *= y;
-  s.vertices.col(2) *= z;
-  return s;
-}
-
-Surface flipped(Surface s) {
-  s.faces.col(1).swap(s.faces.col(2));
-  return s;
-}
 
 // RMS angle between the directions of starts and ends, times the radius r of the end sphere.
 double radial_rms(const Points3& starts, const Points3& ends, double r) {
