@@ -93,6 +93,35 @@ bool all_rows_equal(const Points2& points) {
   return true;
 }
 
+// Streamlines of one flow do not cross, but two that run a hair apart can come out swapped by
+// rounding and step error (seen where they converge onto a small curve): the ends, taken in the
+// order of their start points, are put back in order along the target, the set of ends kept.
+// Positions are unrolled step by step (the shorter way between neighbours on a closed curve), so
+// only local swaps move.
+void put_in_order(Points2& ends, const ArcCurve& target) {
+  std::vector<Index> rows;
+  for (Index i = 0; i < ends.rows(); ++i) {
+    if (ends.row(i).allFinite()) rows.push_back(i);
+  }
+  if (rows.size() < 2) return;
+  const Points2 found = ends(rows, Eigen::all);
+  const Vector arcs = CurveIndex(target.points(), target.closed()).closest_points(found).arc_lengths;
+  const double length = target.length();
+  std::vector<double> unrolled(rows.size(), 0.0);
+  for (std::size_t k = 1; k < rows.size(); ++k) {
+    double step = arcs[k] - arcs[k - 1];
+    if (target.closed()) step -= length * std::round(step / length);
+    unrolled[k] = unrolled[k - 1] + step;
+  }
+  const double direction = unrolled.back() >= 0.0 ? 1.0 : -1.0;
+  for (double& u : unrolled) u *= direction;
+  if (std::is_sorted(unrolled.begin(), unrolled.end())) return;
+  std::sort(unrolled.begin(), unrolled.end());
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    ends.row(rows[k]) = target.point_at(arcs[0] + direction * unrolled[k]).transpose();
+  }
+}
+
 Points2 basic_ends(MapMethod method, const Job& job, const Points2& starts, const Settings& settings) {
   if (starts.rows() == 0) return Points2(0, 2);
   // A piece of the target that shrank to a point (two meetings at one place) takes all starts.
@@ -115,6 +144,7 @@ Points2 basic_ends(MapMethod method, const Job& job, const Points2& starts, cons
       const DiffusionSolution solution = solve_diffusion(job.source, job.target, job.source_closed, settings.diffusion);
       Points2 ends(starts.rows(), 2);
       for (std::size_t j = 0; j < job.start_rows.size(); ++j) ends.row(j) = solution.ends.row(job.start_rows[j]);
+      put_in_order(ends, target);
       return ends;
     }
     case MapMethod::automatic:
