@@ -79,8 +79,10 @@ def test_result_arrays(spheres):
 
 def test_refinement_reduces_error():
     inner, outer = sphere(1.0, 3), sphere(4.0, 3)
+    # Near S1 the default mesh is already graded from 2% of S1's diagonal, so a mesh_size of 0.35
+    # changes nothing (149k tetrahedra either way): 0.2 refines (216k; RMS 9.2e-3 -> 7.6e-3).
     coarse = mm.solve_diffusion_3d(inner, outer, mesh_size=1.0)
-    fine = mm.solve_diffusion_3d(inner, outer, mesh_size=0.35)
+    fine = mm.solve_diffusion_3d(inner, outer, mesh_size=0.2)
     assert len(fine.tetrahedra) > len(coarse.tetrahedra)
     assert angular_rms(inner[0], fine.ends, 4) < angular_rms(inner[0], coarse.ends, 4)
 
