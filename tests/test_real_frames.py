@@ -242,3 +242,15 @@ def test_an_interrupted_write_leaves_the_old_file(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["field.csv"]
     mm.write_field(target, field)
     assert len(mm.read_field(target)) == 50
+
+
+@pytest.mark.parametrize("method", ["auto", "normal", "minimal_distance", "diffusion", "uniform"])
+def test_curves_that_lie_apart_are_refused(method):
+    with pytest.raises(ValueError, match="c2: lies apart from c1"):
+        mm.map_curves(circle(100, 1.0), circle(100, 1.0, centre=(5.0, 0.0)), method)
+
+
+@pytest.mark.parametrize("method", ["normal", "minimal_distance", "diffusion", "auto"])
+def test_surfaces_that_lie_apart_are_refused(method):
+    with pytest.raises(ValueError, match="s2: lies apart from s1"):
+        mm.map_surfaces(icosphere(1.0), icosphere(1.0, (5.0, 0.0, 0.0)), method)

@@ -6,6 +6,7 @@
 #include <morphomap/transform.hpp>
 
 #include "dirichlet.hpp"
+#include "inside.hpp"
 #include "interrupt_check.hpp"
 #include "region_mesh.hpp"
 #include "validation.hpp"
@@ -31,20 +32,6 @@ using detail::source_vertex;
 using detail::target_vertex;
 
 double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
-
-// Even-odd test; only used for curves known not to cross.
-bool inside(const Vec2& p, const Points2& polygon) {
-  bool in = false;
-  const Index n = polygon.rows();
-  for (Index i = 0, j = n - 1; i < n; j = i++) {
-    const double yi = polygon(i, 1), yj = polygon(j, 1);
-    if ((yi > p.y()) != (yj > p.y())) {
-      const double x = polygon(j, 0) + (p.y() - yj) * (polygon(i, 0) - polygon(j, 0)) / (yi - yj);
-      if (p.x() < x) in = !in;
-    }
-  }
-  return in;
-}
 
 // The P1 solution on the triangles: local stiffness grad phi_i . grad phi_j * area.
 Vector solve_potential(const detail::RegionMesh& mesh, const std::vector<char>& kind) {
@@ -362,7 +349,7 @@ DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2
   bool crossing = false;
   if (closed) {
     crossing = curve_intersections(source, target, true).points.rows() > 0;
-    if (!crossing && !inside(source.row(0).transpose(), target) && !inside(target.row(0).transpose(), source)) {
+    if (!crossing && !detail::inside(source.row(0).transpose(), target) && !detail::inside(target.row(0).transpose(), source)) {
       detail::invalid("c2", "diffusion mapping needs one curve inside the other, or crossing curves");
     }
     loops = {source, target};

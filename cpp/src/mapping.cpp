@@ -11,6 +11,7 @@
 
 #include "arc_curve.hpp"
 #include "contact.hpp"
+#include "inside.hpp"
 #include "interrupt_check.hpp"
 #include "validation.hpp"
 
@@ -527,6 +528,20 @@ DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2,
     detail::invalid("contact_tolerance", "must be a finite length >= 0, or negative for the default");
   }
   detail::require_diffusion_options(options.diffusion);
+  // Frames of one organ overlap; closed curves that neither cross nor nest are the wrong pair
+  // (other units, another offset), whatever a method would make of them.
+  // (Each curve's point farthest from the other decides: a touching point would not.)
+  auto farthest = [](const Points2Ref& points, const Points2Ref& curve) -> Vec2 {
+    Index at = 0;
+    CurveIndex(curve, true).closest_points(points).distances.maxCoeff(&at);
+    return points.row(at).transpose();
+  };
+  if (closed && curve_intersections(c1.topRows(n1), c2.topRows(n2), true).points.rows() == 0 &&
+      !detail::inside(farthest(c1.topRows(n1), c2.topRows(n2)), c2.topRows(n2)) &&
+      !detail::inside(farthest(c2.topRows(n2), c1.topRows(n1)), c1.topRows(n1))) {
+    detail::invalid("c2", "lies apart from c1 (the curves neither cross nor enclose one another): consecutive "
+                          "frames of one organ overlap; check their units and offsets");
+  }
   Points2 a = options.n > 0 ? resample(c1, options.n, closed) : Points2(c1.topRows(n1));
   const Points2 b = options.n > 0 ? resample(c2, options.n, closed) : Points2(c2.topRows(n2));
 

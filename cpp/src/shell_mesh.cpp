@@ -168,13 +168,11 @@ ShellMesh to_shell_mesh(const C3t3& c3t3, PatchKind patch_kind) {
 
 }  // namespace
 
-bool surface_self_intersects(const Points3Ref& vertices, const FacesRef& faces) {
-  try {
-    return CGAL::Polygon_mesh_processing::does_self_intersect(to_surface_mesh(vertices, faces));
-  } catch (const CGAL::Failure_exception& e) {
-    throw GeometryError(std::string("testing the surface for self-intersections failed: ") + e.what());
-  }
-}
+namespace {
+constexpr const char* kSelfIntersecting =
+    "intersects itself; the mapping needs a simple closed surface (a mask contoured without "
+    "smoothing can touch itself at a voxel edge: smooth or remesh it)";
+}  // namespace
 
 Nesting classify_nesting(const Points3Ref& source_vertices, const FacesRef& source_faces,
                          const Points3Ref& target_vertices, const FacesRef& target_faces) {
@@ -183,10 +181,10 @@ Nesting classify_nesting(const Points3Ref& source_vertices, const FacesRef& sour
     const SurfaceMesh target = to_surface_mesh(target_vertices, target_faces);
     // Mesh_3 on a self-intersecting surface may crash rather than fail.
     if (CGAL::Polygon_mesh_processing::does_self_intersect(source)) {
-      throw InvalidInput("s1: intersects itself; diffusion mapping needs surfaces without self-intersections");
+      throw InvalidInput(std::string("s1: ") + kSelfIntersecting);
     }
     if (CGAL::Polygon_mesh_processing::does_self_intersect(target)) {
-      throw InvalidInput("s2: intersects itself; diffusion mapping needs surfaces without self-intersections");
+      throw InvalidInput(std::string("s2: ") + kSelfIntersecting);
     }
     if (CGAL::Polygon_mesh_processing::do_intersect(source, target)) return Nesting::crossing;
     const CGAL::Side_of_triangle_mesh<SurfaceMesh, Kernel> in_target(target), in_source(source);

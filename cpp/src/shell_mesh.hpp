@@ -8,9 +8,6 @@
 
 namespace morphomap::detail {
 
-// Whether two faces of a closed surface meet other than at their shared edges and vertices.
-bool surface_self_intersects(const Points3Ref& vertices, const FacesRef& faces);
-
 // How two closed, outward-oriented surfaces lie relative to each other. Throws InvalidInput if
 // either intersects itself.
 enum class Nesting { source_inside, target_inside, disjoint, crossing };

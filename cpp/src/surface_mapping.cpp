@@ -12,7 +12,6 @@
 
 #include <cmath>
 #include <limits>
-#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -125,12 +124,11 @@ DisplacementField3 map_surfaces(const Points3Ref& v1, const FacesRef& f1, const 
                                 const SurfaceMappingOptions& options) {
   detail::require_outward(check_closed_surface(v1, f1, "s1"), "s1");
   detail::require_outward(check_closed_surface(v2, f2, "s2"), "s2");
-  for (const auto& [vertices, faces, name] : {std::tuple(&v1, &f1, "s1"), std::tuple(&v2, &f2, "s2")}) {
-    if (detail::surface_self_intersects(*vertices, *faces)) {
-      detail::invalid(name, "the surface intersects itself; the mapping needs a simple closed surface "
-                            "(a mask contoured without smoothing can touch itself at a voxel edge: "
-                            "smooth or remesh it)");
-    }
+  // Both surfaces free of self-intersections (classify_nesting checks), and overlapping: frames
+  // of one organ do (see map_curves).
+  if (detail::classify_nesting(v1, f1, v2, f2) == detail::Nesting::disjoint) {
+    detail::invalid("s2", "lies apart from s1 (the surfaces neither cross nor enclose one another): consecutive "
+                          "frames of one organ overlap; check their units and offsets");
   }
   if (options.method == MapMethod::uniform) {
     detail::invalid("method", "uniform mapping has no 3D form; use 'minimal_distance', 'normal', 'diffusion' or 'auto'");
