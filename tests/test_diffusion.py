@@ -127,6 +127,8 @@ def test_open_curves():
 
 def test_disjoint_curves_are_refused():
     with pytest.raises(ValueError, match="c2: diffusion mapping needs one curve inside the other"):
+        mm.solve_diffusion(circle(50), circle(50, centre=(5.0, 0.0)))
+    with pytest.raises(ValueError, match="c2: lies apart from c1"):  # every method says so
         mm.map_curves(circle(50), circle(50, centre=(5.0, 0.0)), "diffusion")
 
 

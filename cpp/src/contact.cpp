@@ -154,23 +154,36 @@ std::vector<Meeting> meetings_in_order(const std::vector<Meeting>& meetings, con
   std::vector<Meeting> kept;
   *all_in_order = true;
   if (meetings.empty()) return kept;
-  const double origin = meetings[0].target_begin;
+  double origin = 0.0;  // the first kept meeting's start
   // Distance walked along the target (in direction) from the first meeting's start.
-  auto along = [&](double t) {
+  auto along = [&](double t) {  // only once a meeting is kept
     if (!target.closed()) return t - origin;
     return direction > 0 ? target.forward(origin, t) : target.forward(t, origin);
   };
   double last = -std::numeric_limits<double>::infinity();
+  const double length = target.length();
   for (const Meeting& meeting : meetings) {
+    // Along the target from the stretch's start to its end, in direction, or against it: the
+    // way whose length is nearer to the stretch's length on the source. A stretch that runs
+    // against it (the curves touch there from opposite sides) cannot be walked in order with the
+    // others and is left out.
+    double span = meeting.target_end - meeting.target_begin;
+    if (target.closed()) {
+      const double with = direction > 0 ? target.forward(meeting.target_begin, meeting.target_end)
+                                        : target.forward(meeting.target_end, meeting.target_begin);
+      const double on_source = meeting.source_end - meeting.source_begin;
+      span = std::abs(with - on_source) <= std::abs(length - with - on_source) ? with : -(length - with);
+    }
+    if (!meeting.crossing && span < -1e-12 * length) {
+      *all_in_order = false;
+      continue;
+    }
+    span = std::max(span, 0.0);
     const double begin = kept.empty() ? 0.0 : along(meeting.target_begin);
-    const double span = !target.closed() ? meeting.target_end - meeting.target_begin
-                        : direction > 0  ? target.forward(meeting.target_begin, meeting.target_end)
-                                         : target.forward(meeting.target_end, meeting.target_begin);
-    // A stretch that runs the other way along the target (beyond rounding) cannot be walked.
-    const bool forward_stretch = meeting.crossing || span >= 0.0;
-    if ((kept.empty() || begin > last) && forward_stretch && begin + span < target.length() + 1e-12 * target.length()) {
+    if ((kept.empty() || begin > last) && begin + span < length + 1e-12 * length) {
+      if (kept.empty()) origin = meeting.target_begin;
       kept.push_back(meeting);
-      last = begin + std::max(span, 0.0);
+      last = begin + span;
     } else {
       *all_in_order = false;
     }

@@ -244,7 +244,9 @@ Vectors run(MapMethod method, const Job& job, const std::vector<double>& start_k
     try {
       Vectors v = backwards ? reverse(MapMethod::diffusion, job, whole_source, settings)
                             : forward(MapMethod::diffusion, job, start_keys, settings);
-      if (complete(v)) return v;
+      // (A reverse mapping from a target piece without points of its own between the two
+      // meetings has no vectors at all: that leaves the piece of C1 unmapped, not complete.)
+      if (complete(v) && v.starts.rows() > 0) return v;
     } catch (const GeometryError&) {
     } catch (const InvalidInput&) {  // a piece the region of which is not what diffusion needs
     }
