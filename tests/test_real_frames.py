@@ -91,6 +91,8 @@ def test_touching_at_one_point_is_a_split():
         field = mm.map_curves(c1, c2, method)
         assert field.valid.all() and mm.quality(field, c1, c2).crossings == 0
         assert distance_to(field.ends, c2).max() < 1e-9
+        # Not all onto the touching point (a piece from the point round to itself did that).
+        assert len(np.unique(field.ends, axis=0)) == len(field)
 
 
 def test_resampled_fields_lie_on_the_given_curves():

@@ -338,6 +338,9 @@ Vectors map_directed(const Points2& source_points, const Points2& target_points,
   // Crossings alone that do not pair up in order: map the whole curves (diffusion handles
   // crossing curves as one region).
   if (!in_order && !contact) meetings.clear();
+  // A closed pair that meets at one point only has no two pieces to pair: the piece between the
+  // point and itself would be the whole curve onto a point of the target. Map the whole curves.
+  if (closed && meetings.size() == 1 && meetings[0].source_begin == meetings[0].source_end) meetings.clear();
 
   auto add_starts = [&](Job& job, const std::vector<Index>& points, Index first_row) {
     for (std::size_t j = 0; j < points.size(); ++j) job.start_rows.push_back(first_row + j);

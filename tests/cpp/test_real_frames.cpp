@@ -111,6 +111,10 @@ void touching_circles_are_a_split() {
     CHECK(all_valid(field));
     CHECK(count_crossings(field.starts, field.ends) == 0);
     CHECK(farthest_from(field.ends, outer) < 1e-12);
+    // Not all onto the touching point (a piece from the point round to itself did that).
+    Index repeated = 0;
+    for (Index i = 1; i < field.size(); ++i) repeated += field.ends.row(i) == field.ends.row(i - 1) ? 1 : 0;
+    CHECK(repeated == 0);
   }
 }
 
