@@ -70,13 +70,13 @@ def as_point(value, name: str, dim: int = 2) -> np.ndarray:
     return as_points(array.reshape(1, dim), name, dim)[0]
 
 
-def as_length(value, name: str, default: float) -> float:
-    """Return ``value`` as a finite float > 0, or ``default`` for None."""
+def as_length(value, name: str, default: float, *, allow_zero: bool = False) -> float:
+    """Return ``value`` as a finite float > 0 (>= 0 with ``allow_zero``), or ``default`` for None."""
     if value is None:
         return default
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
         raise TypeError(f"{name}: expected a number, got {type(value).__name__}")
     value = float(value)
-    if not np.isfinite(value) or value <= 0:
-        raise ValueError(f"{name}: must be a finite number > 0, got {value}")
+    if not np.isfinite(value) or value < 0 or (value == 0 and not allow_zero):
+        raise ValueError(f"{name}: must be a finite number {'>=' if allow_zero else '>'} 0, got {value}")
     return value

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._validate import as_points
+from .curves import signed_area
 from .surfaces import as_surface
 
 
@@ -40,11 +41,6 @@ def _loops(points: np.ndarray, gap: float | None) -> list[np.ndarray]:
     return loops
 
 
-def _area(loop: np.ndarray) -> float:
-    x, y = loop[:, 0] - loop[:, 0].mean(), loop[:, 1] - loop[:, 1].mean()
-    return 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
-
-
 def split_components(value, *, gap=None):
     """Split one curve array or one triangle mesh into its separate objects, largest first.
 
@@ -70,7 +66,7 @@ def split_components(value, *, gap=None):
         points = as_points(value, "value")
         if gap is not None and (not np.isfinite(gap) or gap <= 0):
             raise ValueError(f"gap: must be a finite length > 0, got {gap}")
-        return sorted(_loops(points, gap), key=_area, reverse=True)
+        return sorted(_loops(points, gap), key=lambda loop: abs(signed_area(loop)), reverse=True)
     import trimesh
 
     vertices, faces = as_surface(value, "value")

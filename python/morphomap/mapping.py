@@ -23,16 +23,6 @@ def _threshold(value) -> float:
     return float(value)
 
 
-def _tolerance(value) -> float:
-    if value is None:
-        return -1.0  # the core's default
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
-        raise TypeError(f"contact_tolerance: expected a number, got {type(value).__name__}")
-    if not np.isfinite(value) or value < 0:
-        raise ValueError(f"contact_tolerance: must be a finite length >= 0, got {value}")
-    return float(value)
-
-
 def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, transform=False,
                split=True, anchor=None, density_threshold=None, contact_tolerance=None,
                mesh_size=None, mesh_fraction=0.02) -> DisplacementField:
@@ -111,6 +101,6 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
     starts, ends, codes = _core.map_curves(
         as_points(c1, "c1"), as_points(c2, "c2"), method, closed, count,
         as_flag(reverse, "reverse"), as_flag(transform, "transform"), as_flag(split, "split"), anchor,
-        _threshold(density_threshold), _tolerance(contact_tolerance),
+        _threshold(density_threshold), as_length(contact_tolerance, "contact_tolerance", -1.0, allow_zero=True),
         as_length(mesh_size, "mesh_size", 0.0), as_length(mesh_fraction, "mesh_fraction", 0.02))
     return DisplacementField._from_core(starts, ends, codes)
