@@ -256,3 +256,21 @@ def test_curves_that_lie_apart_are_refused(method):
 def test_surfaces_that_lie_apart_are_refused(method):
     with pytest.raises(ValueError, match="s2: lies apart from s1"):
         mm.map_surfaces(icosphere(1.0), icosphere(1.0, (5.0, 0.0, 0.0)), method)
+
+
+@pytest.mark.parametrize("reverse", [False, True])
+def test_diffusion_repairs_the_slivers_it_folds(reverse):
+    """Fuzz seed 732004074 (3D, smoothed marching cubes, voxels 2 x 1 x 1): diffusion flipped one
+    sliver 0.02 wide, narrower than the tetrahedral mesh's distance to the surfaces (0.05)."""
+    import frames
+
+    made = frames.pair(3, 732004074, None)
+    field = mm.map_surfaces(made.s1, made.s2, method="diffusion", reverse=reverse)
+    assert np.all(field.valid)
+    assert mm.quality(field, made.s1, made.s2).folds == 0
+    # The repaired ends still lie on S2 (the starts, on reverse).
+    on = field.starts if reverse else field.ends
+    target = made.s1 if reverse else made.s2
+    vertices, faces = target
+    distance = mm.SurfaceIndex(vertices, faces).closest_points(on).distances
+    assert distance.max() < 1e-9 * np.ptp(vertices, axis=0).max()

@@ -2,12 +2,14 @@
 #include <morphomap/quality.hpp>
 #include <morphomap/surface_queries.hpp>
 
+#include "folds.hpp"
 #include "surface_util.hpp"
 #include "validation.hpp"
 
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_reduce.h>
+#include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -123,30 +125,35 @@ Points3 normals_under(const Points3Ref& points, const FacesRef& faces, const std
 
 }  // namespace
 
-Index count_folds(const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, const Points3Ref& v1,
-                  const FacesRef& f1, const SurfaceIndex& index1, const Points3Ref& v2, const FacesRef& f2,
-                  const SurfaceIndex& index2) {
+std::vector<char> detail::folded_faces(const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces,
+                                       const Points3Ref& v1, const FacesRef& f1, const SurfaceIndex& index1,
+                                       const Points3Ref& v2, const FacesRef& f2, const SurfaceIndex& index2) {
   if (ends.rows() != starts.rows()) detail::invalid("ends", "must have as many rows as starts");
   require_field_faces(faces, starts.rows(), "faces");
   std::vector<char> use(faces.rows());
   for (Index j = 0; j < faces.rows(); ++j) use[j] = usable(starts, ends, faces, j);
   const Points3 nu1 = normals_under(starts, faces, use, v1, f1, index1, "s1");
   const Points3 nu2 = normals_under(ends, faces, use, v2, f2, index2, "s2");
-  return tbb::parallel_reduce(
-      tbb::blocked_range<Index>(0, faces.rows(), 1024), Index{0},
-      [&](const tbb::blocked_range<Index>& range, Index count) {
-        for (Index j = range.begin(); j < range.end(); ++j) {
-          if (!use[j]) continue;
-          const V3 p0 = detail::corner(starts, faces, j, 0), q0 = detail::corner(ends, faces, j, 0);
-          const V3 n = (detail::corner(starts, faces, j, 1) - p0).cross(detail::corner(starts, faces, j, 2) - p0);
-          const V3 m = (detail::corner(ends, faces, j, 1) - q0).cross(detail::corner(ends, faces, j, 2) - q0);
-          // Signs only: the product of two dot products of unscaled vectors could underflow.
-          const double on1 = n.dot(nu1.row(j).transpose()), on2 = m.dot(nu2.row(j).transpose());
-          if ((on1 < 0 && on2 > 0) || (on1 > 0 && on2 < 0)) ++count;
-        }
-        return count;
-      },
-      [](Index a, Index b) { return a + b; });
+  std::vector<char> folded(faces.rows(), 0);
+  tbb::parallel_for(tbb::blocked_range<Index>(0, faces.rows(), 1024), [&](const tbb::blocked_range<Index>& range) {
+    for (Index j = range.begin(); j < range.end(); ++j) {
+      if (!use[j]) continue;
+      const V3 p0 = detail::corner(starts, faces, j, 0), q0 = detail::corner(ends, faces, j, 0);
+      const V3 n = (detail::corner(starts, faces, j, 1) - p0).cross(detail::corner(starts, faces, j, 2) - p0);
+      const V3 m = (detail::corner(ends, faces, j, 1) - q0).cross(detail::corner(ends, faces, j, 2) - q0);
+      // Signs only: the product of two dot products of unscaled vectors could underflow.
+      const double on1 = n.dot(nu1.row(j).transpose()), on2 = m.dot(nu2.row(j).transpose());
+      folded[j] = (on1 < 0 && on2 > 0) || (on1 > 0 && on2 < 0);
+    }
+  });
+  return folded;
+}
+
+Index count_folds(const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, const Points3Ref& v1,
+                  const FacesRef& f1, const SurfaceIndex& index1, const Points3Ref& v2, const FacesRef& f2,
+                  const SurfaceIndex& index2) {
+  const std::vector<char> folded = detail::folded_faces(starts, ends, faces, v1, f1, index1, v2, f2, index2);
+  return static_cast<Index>(std::count(folded.begin(), folded.end(), 1));
 }
 
 Index count_folds(const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, const Points3Ref& v1,

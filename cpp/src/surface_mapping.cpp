@@ -5,6 +5,7 @@
 #include <morphomap/surface_mapping.hpp>
 #include <morphomap/surface_queries.hpp>
 
+#include "folds.hpp"
 #include "shell_mesh.hpp"
 #include "validation.hpp"
 
@@ -61,6 +62,9 @@ DisplacementField3 basic(MapMethod method, const Surface& source, const Surface&
       for (std::size_t k = 0; k < rows.size(); ++k) found.row(k) = field.ends.row(rows[k]);
       const Points3 on_target = target_index.closest_points(found).points;
       for (std::size_t k = 0; k < rows.size(); ++k) field.ends.row(rows[k]) = on_target.row(k);
+      // The streamlines do not cross; the few slivers their discrete form flips are repaired.
+      detail::unfold(field.starts, field.ends, field.faces, source.vertices, source.faces,
+                     SurfaceIndex(source.vertices, source.faces), target.vertices, target.faces, target_index);
       field.methods.assign(field.size(), Method::diffusion);
       break;
     }
