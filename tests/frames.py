@@ -517,6 +517,14 @@ def surface_pair(seed: int, style: str | None = None) -> SurfacePair:
             break
     else:  # pragma: no cover
         raise RuntimeError(f"seed {seed}: could not draw two different frames")
+    # One pair in ten instead swells: frame 2 is frame 1's mask dilated by 1-1.8 of the coarsest
+    # voxel, as a thresholded stack grows between time points (the shapes that crashed Mesh_3).
+    # Its own generator, so that the other pairs stay what they were.
+    swell = np.random.default_rng([int(seed), 3, 1])
+    if swell.random() < 0.1:
+        kind = "swell"
+        reach = swell.uniform(1.0, 1.8) * max(spacing)
+        m2 = ndimage.distance_transform_edt(~m1, sampling=spacing) <= reach
     info = dict(dim=3, seed=int(seed), style=style, kind=kind, spacing=spacing, shape=shape,
                 buds=sum(h > 0 for _, h, _ in blob.bumps), necks=sum(h < 0 for _, h, _ in blob.bumps),
                 knobs=len(blob.knobs), attempts=attempt + 1)

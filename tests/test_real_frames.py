@@ -274,3 +274,19 @@ def test_diffusion_repairs_the_slivers_it_folds(reverse):
     vertices, faces = target
     distance = mm.SurfaceIndex(vertices, faces).closest_points(on).distances
     assert distance.max() < 1e-9 * np.ptp(vertices, axis=0).max()
+
+
+@pytest.mark.parametrize("seed", [5002, 5022])
+def test_surfaces_touching_over_a_patch_refuse_diffusion_at_once_and_auto_answers(seed):
+    """Fuzz seeds whose frames are the same mask outside a growing cap (one unsmoothed, one
+    smoothed): the surfaces share or nearly share faces there. Diffusion crashed inside Mesh_3
+    (5022) or spent minutes (a sibling pair took 218 s); now it refuses before meshing, and auto
+    falls back."""
+    import frames
+
+    made = frames.pair(3, seed, None)
+    # The count of faces says the refusal came before meshing (Mesh_3's own refusal has none).
+    with pytest.raises(ValueError, match=r"s2: coincides with s1 over a patch \(\d+ faces of s1 lie within"):
+        mm.map_surfaces(made.s1, made.s2, method="diffusion")
+    field = mm.map_surfaces(made.s1, made.s2, method="auto")
+    assert np.all(field.valid)

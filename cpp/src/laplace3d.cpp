@@ -7,6 +7,7 @@
 
 #include "dirichlet.hpp"
 #include "interrupt_check.hpp"
+#include "mesh_in_child.hpp"
 #include "shell_mesh.hpp"
 #include "validation.hpp"
 
@@ -32,6 +33,9 @@ using Vec3 = Eigen::Vector3d;
 using Vec4 = Eigen::Vector4d;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kSourceFraction = 0.02;
+constexpr int kMeshAttempts = 3;
+// Surfaces closer than this fraction of their finer mean edge touch (as 2D's contact tolerance).
+constexpr double kTouchFraction = 0.01;
 using detail::free_vertex;
 using detail::source_vertex;
 using detail::target_vertex;
@@ -316,6 +320,28 @@ class Tracer {
   std::vector<double> step_;    // RK4 step length in each tetrahedron
 };
 
+// Where the surfaces touch over a patch (frames contoured on one voxel grid where the tissue did
+// not move, smoothed or not), the region between them is no volume there, and Mesh_3 either
+// refuses the exactly shared faces, spends minutes on the sliver between nearly shared ones (fuzz
+// seed 5038: 218 s) or crashes (seed 5022). A patch: a face of S1 with all three corners within
+// `tolerance` of S2.
+void require_no_touching_patch(const Points3Ref& source_vertices, const FacesRef& source_faces,
+                               const Points3Ref& target_vertices, const FacesRef& target_faces, double tolerance) {
+  const Vector distance = SurfaceIndex(target_vertices, target_faces).closest_points(source_vertices).distances;
+  Index touching = 0;
+  for (Index f = 0; f < source_faces.rows(); ++f) {
+    bool near = true;
+    for (int k = 0; k < 3; ++k) near = near && distance[source_faces(f, k)] <= tolerance;
+    touching += near ? 1 : 0;
+  }
+  if (touching > 0) {
+    throw InvalidInput("s2: coincides with s1 over a patch (" + std::to_string(touching) +
+                       " faces of s1 lie within " + std::to_string(tolerance) +
+                       " of it); the region between them is not a volume there, so diffusion cannot map "
+                       "these surfaces: use 'auto' (which falls back) or 'normal'");
+  }
+}
+
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -341,6 +367,8 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
   if (nesting == detail::Nesting::disjoint) {
     throw InvalidInput("s2: diffusion mapping needs surfaces that overlap (these lie apart)");
   }
+  require_no_touching_patch(source_vertices, source_faces, target_vertices, target_faces,
+                            kTouchFraction * std::min(source.mean_edge, target.mean_edge));
   std::unique_ptr<detail::CrossingRegion> crossing;
   if (nesting == detail::Nesting::crossing) {
     crossing = std::make_unique<detail::CrossingRegion>(source_vertices, source_out, target_vertices, target_out);
@@ -364,10 +392,33 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
   criteria.grading = 0.1;
   criteria.exude = true;
   criteria.facet_distance = 0.05 * std::min(criteria.source_size, criteria.target_size);
-  const detail::ShellMesh mesh =
-      crossing ? crossing->mesh(criteria)
-               : detail::mesh_shell(source_vertices, source_out, target_vertices, target_out,
-                                    nesting == detail::Nesting::source_inside, criteria);
+  // In a child process (see mesh_in_child.hpp); after a crash, again with other random choices
+  // and sizes a little finer (the crashes come and go with both).
+  detail::ShellMesh mesh;
+  const detail::ShellMeshCriteria requested = criteria;
+  for (int attempt = 0;; ++attempt) {
+    const double finer = 1.0 - 0.15 * attempt;
+    criteria.seed = attempt;
+    criteria.cell_size = finer * requested.cell_size;
+    criteria.source_size = finer * requested.source_size;
+    criteria.target_size = finer * requested.target_size;
+    criteria.facet_distance = finer * requested.facet_distance;
+    try {
+      mesh = detail::mesh_in_child(
+          [&] {
+            return crossing ? crossing->mesh(criteria)
+                            : detail::mesh_shell(source_vertices, source_out, target_vertices, target_out,
+                                                 nesting == detail::Nesting::source_inside, criteria);
+          },
+          "meshing the region between the surfaces");
+      break;
+    } catch (const detail::MesherCrashed& crash) {
+      if (attempt + 1 == kMeshAttempts) {
+        throw GeometryError(std::string(crash.what()) + " in " + std::to_string(kMeshAttempts) +
+                            " attempts; try another mesh_size");
+      }
+    }
+  }
 
   ShellDiffusionSolution solution;
   solution.seconds.mesh = seconds_since(clock);

@@ -209,7 +209,7 @@ ShellMesh mesh_shell(const Points3Ref& source_vertices, const FacesRef& source_f
     const std::pair<int, int> inner(0, 1), outer(1, 0);
     const std::pair<int, int> sides[2] = {source_inside ? inner : outer, source_inside ? outer : inner};
     const Sizing sizing(patches[0], patches[1], criteria);
-    CGAL::Random random(0);
+    CGAL::Random random(criteria.seed);
     const Domain domain(patches.begin(), patches.end(), sides, sides + 2, &random);
     namespace params = CGAL::parameters;
     const Criteria mesh_criteria(params::facet_angle = 25.0, params::facet_size = sizing,
@@ -353,7 +353,7 @@ ShellMesh CrossingRegion::mesh(const ShellMeshCriteria& criteria) const {
       sides.push_back(p.inside_other[k] ? std::make_pair(0, piece_outside) : std::make_pair(piece_inside, 0));
     }
     const Sizing sizing(p.source, p.target, criteria);
-    CGAL::Random random(0);
+    CGAL::Random random(criteria.seed);
     const Domain domain(p.meshes.begin(), p.meshes.end(), sides.begin(), sides.end(), &random);
     namespace params = CGAL::parameters;
     // First the crossing curves, protected by balls of the local size, and a coarse mesh; then

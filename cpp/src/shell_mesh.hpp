@@ -23,6 +23,7 @@ struct ShellMeshCriteria {
   double cell_size = 0.0;
   double facet_distance = 0.0;  // largest distance between the mesh boundary and the surfaces
   bool exude = true;            // remove slivers after refinement
+  int seed = 0;                 // of the mesher's random choices (another seed, another mesh)
 };
 
 enum FacePatch : signed char { interior_face = 0, source_face = 1, target_face = 2, other_face = -1 };

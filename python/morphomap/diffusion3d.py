@@ -58,7 +58,10 @@ def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False) -> ShellDif
         lies inside the other (the region is the shell between them) or they cross: then the
         region is both pieces of their symmetric difference (S1 outside S2, bounded by that part
         of S1 and the part of S2 inside S1; and S2 outside S1), meshed with the crossing curves
-        as edges, where c = 0. Surfaces that lie apart or coincide over a patch raise ValueError.
+        as edges, where c = 0. Surfaces that lie apart or coincide over a patch (a face of S1
+        within 1% of the finer mean edge of S2 at all three corners, as where frames contoured
+        on one voxel grid share faces) raise ValueError; ``map_surfaces(..., method="auto")``
+        falls back to normal mapping there.
     mesh_size : float, optional
         Largest tetrahedron size. Default: a quarter of the mean gap (the region's volume over the
         mean area of the surfaces). Near each surface the mesh follows its mean edge length (or

@@ -37,7 +37,10 @@ struct ShellDiffusionSolution {
 // shell between them when one lies inside the other (which one is found); when they cross, the
 // pieces of their symmetric difference (S1 outside S2, S2 outside S1), each bounded by parts of
 // both, meshed together with the crossing curves as mesh edges (c = 0 on them). Surfaces that lie
-// apart, intersect themselves or coincide over a patch: InvalidInput. Streamlines start on the
+// apart, intersect themselves or coincide over a patch (a face of S1 within 1% of the finer mean
+// edge of S2 at all three corners): InvalidInput. Mesh_3 runs in a child process where fork exists
+// (it can crash on valid input); a crash there is retried twice with other random choices and
+// slightly finer sizes, then a GeometryError. Streamlines start on the
 // mesh boundary at the closest point to each source vertex and follow the recovered, linearly
 // interpolated -grad c in RK4 steps (in the tetrahedra at a crossing curve, where c jumps, each
 // one's own P1 gradient); where one leaves the mesh through the target boundary, its end is moved
