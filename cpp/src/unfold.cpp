@@ -57,8 +57,9 @@ V2 centroid(const std::vector<V2>& polygon) {
 }
 
 // The new end of vertex v: inside the kernel of its fan (the triangles `around` it, each a
-// row of `faces`) in the plane through its end with unit normal n; its end unchanged when that
-// already lies inside, NaN when the kernel is empty.
+// row of `faces`) in the plane through its end with unit normal n, a fifth of the way from the
+// kernel's point nearest the old end to its centre (so that a nearly flat triangle, whose sign
+// is noise, opens up too); NaN when the kernel is empty.
 V3 into_kernel(Index v, const std::vector<Index>& around, const FacesRef& faces, const Points3& ends, const V3& n) {
   const V3 origin = ends.row(v).transpose();
   const V3 t1 = n.unitOrthogonal(), t2 = n.cross(t1);
@@ -76,9 +77,6 @@ V3 into_kernel(Index v, const std::vector<Index>& around, const FacesRef& faces,
     edges.push_back({flat(a), flat(b)});
     reach = std::max({reach, edges.back()[0].norm(), edges.back()[1].norm()});
   }
-  bool inside = true;
-  for (const auto& e : edges) inside = inside && cross2(e[1] - e[0], -e[0]) > 0;
-  if (inside) return origin;
   const double r = 2.0 * reach;
   std::vector<V2> kernel = {V2(-r, -r), V2(r, -r), V2(r, r), V2(-r, r)};
   for (const auto& e : edges) {
@@ -132,21 +130,36 @@ Index unfold(const Points3Ref& starts, Points3& ends, const FacesRef& faces, con
       if (region[v] && ends.row(v).allFinite()) rows.push_back(v);
     }
     // Gauss-Seidel sweeps: each vertex from its neighbours' current ends, in the plane of the
-    // surface under its end.
+    // surface under its fan (the normals the fold test uses: S2's under the fan's corners and
+    // centroids; at a crease of S2 one face's normal would disagree with it).
     Points3 trial = ends;
     for (int sweep = 0; sweep < 3; ++sweep) {
-      Points3 at(static_cast<Index>(rows.size()), 3);
-      for (std::size_t k = 0; k < rows.size(); ++k) at.row(static_cast<Index>(k)) = trial.row(rows[k]);
-      const SurfaceHits under = index2.closest_points(at);
-      for (std::size_t k = 0; k < rows.size(); ++k) {
-        const Index face = under.faces[static_cast<Index>(k)];
-        const V3 a = corner(v2, f2, face, 0);
-        const V3 normal = (corner(v2, f2, face, 1) - a).cross(corner(v2, f2, face, 2) - a);
+      for (const Index v : rows) {
+        const std::vector<Index>& fan = around[v];
+        Points3 at(static_cast<Index>(4 * fan.size()), 3);
+        bool finite = true;
+        for (std::size_t i = 0; i < fan.size(); ++i) {
+          V3 centroid = V3::Zero();
+          for (int k = 0; k < 3; ++k) {
+            at.row(static_cast<Index>(4 * i + k)) = trial.row(faces(fan[i], k));
+            centroid += trial.row(faces(fan[i], k)).transpose() / 3.0;
+          }
+          at.row(static_cast<Index>(4 * i + 3)) = centroid.transpose();
+          finite = finite && at.block(static_cast<Index>(4 * i), 0, 4, 3).allFinite();
+        }
+        if (!finite) continue;
+        const IndexVector under = index2.closest_points(at).faces;
+        V3 normal = V3::Zero();
+        for (Index k = 0; k < under.size(); ++k) {
+          const V3 a = corner(v2, f2, under[k], 0);
+          const V3 m = (corner(v2, f2, under[k], 1) - a).cross(corner(v2, f2, under[k], 2) - a);
+          if (m.norm() > 0) normal += m.normalized();
+        }
         if (!(normal.norm() > 0)) continue;
-        const V3 end = into_kernel(rows[k], around[rows[k]], faces, trial, normal.normalized());
+        const V3 end = into_kernel(v, fan, faces, trial, normal.normalized());
         if (!end.allFinite()) continue;
         const Points3 one = end.transpose();
-        trial.row(rows[k]) = index2.closest_points(one).points.row(0);
+        trial.row(v) = index2.closest_points(one).points.row(0);
       }
     }
     std::vector<char> trial_folded = folded_faces(starts, trial, faces, v1, f1, index1, v2, f2, index2);
