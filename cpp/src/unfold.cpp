@@ -73,7 +73,8 @@ V3 into_kernel(Index v, const std::vector<Index>& around, const FacesRef& faces,
     int k = 0;
     while (faces(j, k) != v) ++k;
     const Index a = faces(j, (k + 1) % 3), b = faces(j, (k + 2) % 3);
-    if (!ends.row(a).allFinite() || !ends.row(b).allFinite()) return V3::Constant(std::numeric_limits<double>::quiet_NaN());
+    // A triangle with a lost corner is no fold (quality leaves it out) and constrains nothing.
+    if (!ends.row(a).allFinite() || !ends.row(b).allFinite()) continue;
     edges.push_back({flat(a), flat(b)});
     reach = std::max({reach, edges.back()[0].norm(), edges.back()[1].norm()});
   }
@@ -135,9 +136,14 @@ Index unfold(const Points3Ref& starts, Points3& ends, const FacesRef& faces, con
     Points3 trial = ends;
     for (int sweep = 0; sweep < 3; ++sweep) {
       for (const Index v : rows) {
-        const std::vector<Index>& fan = around[v];
+        std::vector<Index> fan;  // the triangles around v with every corner found
+        for (const Index j : around[v]) {
+          bool found = true;
+          for (int k = 0; k < 3; ++k) found = found && trial.row(faces(j, k)).allFinite();
+          if (found) fan.push_back(j);
+        }
+        if (fan.empty()) continue;
         Points3 at(static_cast<Index>(4 * fan.size()), 3);
-        bool finite = true;
         for (std::size_t i = 0; i < fan.size(); ++i) {
           V3 centroid = V3::Zero();
           for (int k = 0; k < 3; ++k) {
@@ -145,9 +151,7 @@ Index unfold(const Points3Ref& starts, Points3& ends, const FacesRef& faces, con
             centroid += trial.row(faces(fan[i], k)).transpose() / 3.0;
           }
           at.row(static_cast<Index>(4 * i + 3)) = centroid.transpose();
-          finite = finite && at.block(static_cast<Index>(4 * i), 0, 4, 3).allFinite();
         }
-        if (!finite) continue;
         const IndexVector under = index2.closest_points(at).faces;
         V3 normal = V3::Zero();
         for (Index k = 0; k < under.size(); ++k) {
