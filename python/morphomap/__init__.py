@@ -24,6 +24,7 @@ from .diffusion3d import ShellDiffusionSolution, solve_diffusion_3d
 from .field import DisplacementField
 from .io import load_example, read_curve, read_field, write_curve, write_field
 from .mapping import map_curves
+from .masks import boundary_from_mask
 from .plot import plot_field
 from .quality import CurveQuality, SurfaceQuality, quality
 from .queries import CurveHits, CurveIndex, closest_points, line_intersections
@@ -53,6 +54,7 @@ __all__ = [
     "SurfaceQuality",
     "align_curves",
     "arc_lengths",
+    "boundary_from_mask",
     "build_info",
     "closest_points",
     "count_crossings",

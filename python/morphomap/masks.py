@@ -1,0 +1,121 @@
+"""Boundaries from segmented images: the first step of the paper's pipeline (its Figure 1 a -> b).
+
+Contouring is scikit-image's marching squares (``skimage.measure.find_contours``), smoothing
+scipy's Gaussian filter and object counting scipy's labelling: well-kept code that labs already
+use, so that a boundary made here is the one their own scripts would make.
+"""
+
+from __future__ import annotations
+
+import numbers
+
+import numpy as np
+
+from ._validate import as_length
+
+
+def _spacing_2d(spacing) -> tuple[float, float]:
+    """(row, column) spacing from one number or a pair in the image's axis order."""
+    values = np.atleast_1d(np.asarray(spacing, dtype=object))
+    if values.ndim != 1 or len(values) not in (1, 2):
+        raise ValueError(f"spacing: expected one number or one per axis (rows, columns), got {spacing!r}")
+    lengths = [as_length(v, "spacing", 1.0) for v in values]
+    return (lengths[0], lengths[0]) if len(lengths) == 1 else (lengths[0], lengths[1])
+
+
+def _object(mask, label, name: str) -> np.ndarray:
+    """The boolean image of the one object to contour: ``label``'s pixels, or the foreground."""
+    array = np.asarray(mask)
+    if array.dtype == object or not (np.issubdtype(array.dtype, np.integer) or array.dtype == bool):
+        raise TypeError(f"{name}: expected a boolean mask or an integer label image, got dtype {array.dtype}")
+    if array.ndim != 2:
+        raise ValueError(f"{name}: expected a 2D image, got shape {array.shape}")
+    if label is None:
+        labels = np.unique(array[array != 0])
+        if len(labels) > 1 and array.dtype != bool:
+            shown = ", ".join(str(v) for v in labels[:8]) + (", ..." if len(labels) > 8 else "")
+            raise ValueError(f"{name}: a label image with {len(labels)} labels ({shown}): pass label= to pick one")
+        return array != 0
+    if isinstance(label, (bool, np.bool_)) or not isinstance(label, numbers.Integral):
+        raise TypeError(f"label: expected an integer, got {type(label).__name__}")
+    chosen = array == label
+    if not chosen.any():
+        raise ValueError(f"label: no pixel of {name} has the value {label}")
+    return chosen
+
+
+def _require_one_object(pixels: np.ndarray, name: str) -> None:
+    from scipy import ndimage
+
+    # 4-connectivity: marching squares at level 0.5 separates pixels that touch only at a corner.
+    components, count = ndimage.label(pixels)
+    if count == 0:
+        raise ValueError(f"{name}: has no foreground pixel")
+    if count > 1:
+        sizes = np.sort(np.bincount(components.ravel())[1:])[::-1]
+        shown = ", ".join(str(s) for s in sizes[:6]) + (", ..." if count > 6 else "")
+        raise ValueError(f"{name}: {count} separate objects ({shown} pixels), as when debris is segmented "
+                         f"with the organ: keep one (scipy.ndimage.label) or pass a label image and label=")
+
+
+def _signed_area(points: np.ndarray) -> float:
+    x, y = points[:, 0], points[:, 1]
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+
+
+def boundary_from_mask(mask, spacing=1.0, *, label=None, smooth=0.0) -> np.ndarray:
+    """The boundary of the object in a 2D mask, as a closed curve in physical units.
+
+    Parameters
+    ----------
+    mask : (rows, columns) bool or integer array
+        A binary mask (non-zero is the object) or a label image (``label`` picks the object).
+        The mask must hold one object (4-connected); its holes are ignored: the curve is the
+        outer boundary.
+    spacing : float or (row spacing, column spacing)
+        Pixel size, in the image's axis order (as a stack's ``(sz, sy, sx)`` in 3D).
+    label : int, optional
+        The value of the object in a label image; required when the image holds several labels.
+    smooth : float
+        Width (standard deviation, in physical units) of a Gaussian applied to the mask before
+        contouring; 0 contours the pixels as they are.
+
+    Returns
+    -------
+    (N, 2) float array
+        The curve without a repeated end point, counter-clockwise in (x, y), with
+        **x = column * column spacing and y = row * row spacing** (the image's own axes, as Fiji
+        reports coordinates: y grows downwards on the screen, so the curve turns clockwise as
+        the image is shown). Sub-pixel: the level 0.5 of the (smoothed) mask by marching
+        squares, which puts it half a pixel outside the centres of the object's edge pixels.
+        Unsmoothed, the curve follows the pixels' staircase: a disc of radius 50 pixels gives
+        its area within 0.5% but a perimeter 5.6% too long; ``smooth`` of one pixel brings the
+        perimeter within 0.5% too.
+    """
+    from scipy import ndimage
+    from skimage import measure
+
+    pixels = _object(mask, label, "mask")
+    row_spacing, column_spacing = _spacing_2d(spacing)
+    sigma = as_length(smooth, "smooth", 0.0, allow_zero=True)
+    _require_one_object(pixels, "mask")
+    # Padding closes the contour of an object touching the border; with smoothing it must hold
+    # the Gaussian's reach too.
+    pad = 1 + int(np.ceil(4 * sigma / min(row_spacing, column_spacing)))
+    image = np.pad(pixels.astype(float), pad)
+    if sigma > 0:
+        image = ndimage.gaussian_filter(image, (sigma / row_spacing, sigma / column_spacing))
+    contours = [c for c in measure.find_contours(image, 0.5) if len(c) >= 4]
+    if not contours:
+        raise ValueError(f"mask: the object vanishes when smoothed by {sigma}: use a smaller smooth=")
+    outer = max(contours, key=lambda c: abs(_signed_area(c)))
+    # The other contours are holes (inside the outer one) unless smoothing cut a neck.
+    apart = [c for c in contours if c is not outer and not measure.points_in_poly(c[:1], outer)[0]]
+    if apart:
+        raise ValueError(f"smooth: a Gaussian of width {sigma} splits the object into {len(apart) + 1} pieces: "
+                         f"use a smaller smooth=")
+    rows_columns = outer[:-1]  # the outer boundary, without its repeated end point
+    curve = np.column_stack([(rows_columns[:, 1] - pad) * column_spacing, (rows_columns[:, 0] - pad) * row_spacing])
+    if _signed_area(curve) < 0:
+        curve = curve[::-1]
+    return np.ascontiguousarray(curve)
