@@ -22,6 +22,7 @@ from .curves import (
 from .diffusion import DiffusionSolution, solve_diffusion
 from .diffusion3d import ShellDiffusionSolution, solve_diffusion_3d
 from .field import DisplacementField
+from .images import Image, read_image
 from .io import load_example, read_curve, read_field, write_curve, write_field
 from .mapping import map_curves
 from .masks import boundary_from_mask
@@ -46,6 +47,7 @@ __all__ = [
     "DiffusionSolution",
     "DisplacementField",
     "GeometryError",
+    "Image",
     "InvalidInput",
     "ShellDiffusionSolution",
     "Similarity",
@@ -73,6 +75,7 @@ __all__ = [
     "quality",
     "read_curve",
     "read_field",
+    "read_image",
     "resample",
     "signed_area",
     "solve_diffusion",
