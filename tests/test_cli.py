@@ -40,3 +40,36 @@ def test_kernels_release_the_gil():
     worker.join()
     # Holding the GIL, the kernel would leave this thread a handful of switch intervals at most.
     assert spins > 1000
+
+
+def test_map_reads_masks(tmp_path):
+    # Two frames of a growing disc as ImageJ TIFFs at 0.5 um per pixel: the command says which
+    # spacing it used, writes the field and maps without crossings.
+    import numpy as np
+    import tifffile
+
+    rows, columns = np.indices((120, 120))
+    for name, radius in (("t0.tif", 20.0), ("t1.tif", 25.0)):
+        mask = ((columns - 60) * 0.5) ** 2 + ((rows - 60) * 0.5) ** 2 <= radius**2
+        tifffile.imwrite(tmp_path / name, mask.astype(np.uint8), imagej=True, resolution=(2.0, 2.0),
+                         metadata={"unit": "um"})
+    out = tmp_path / "field.csv"
+    done = subprocess.run([sys.executable, "-m", "morphomap", "map", str(tmp_path / "t0.tif"), str(tmp_path / "t1.tif"),
+                           "--smooth", "0.5", "-o", str(out)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert "pixel spacing 0.5 x 0.5 (the file)" in done.stderr and "crossings 0" in done.stderr
+    field = mm.read_field(out)
+    lengths = np.linalg.norm(field.ends - field.starts, axis=1)
+    assert np.all(field.valid) and abs(np.median(lengths) - 5.0) < 0.3  # radius 20 -> 25 um
+    # --spacing overrides the file (rows,columns); a bad one is refused by argparse.
+    done = subprocess.run([sys.executable, "-m", "morphomap", "map", str(tmp_path / "t0.tif"), str(tmp_path / "t1.tif"),
+                           "--spacing", "1,1", "-o", str(out)], capture_output=True, text=True)
+    assert done.returncode == 0 and "pixel spacing 1 x 1 (--spacing)" in done.stderr
+    done = subprocess.run([sys.executable, "-m", "morphomap", "map", str(tmp_path / "t0.tif"), str(tmp_path / "t1.tif"),
+                           "--spacing", "1,2,3"], capture_output=True, text=True)
+    assert done.returncode == 2 and "--spacing" in done.stderr
+    # A stack is refused with the way out.
+    np.save(tmp_path / "stack.npy", np.ones((3, 4, 4), np.uint8))
+    done = subprocess.run([sys.executable, "-m", "morphomap", "map", str(tmp_path / "stack.npy"), str(tmp_path / "t1.tif")],
+                          capture_output=True, text=True)
+    assert done.returncode == 2 and "a 3D image" in done.stderr and "map_surfaces" in done.stderr

@@ -42,11 +42,11 @@ def _map(args, parser) -> int:
     curves = []
     for path in (args.c1, args.c2):
         try:
-            curves.append(read_curve(path))
+            curves.append(_read_frame(path, args) if _is_image(path) else read_curve(path))
         except OSError as error:
             parser.error(f"cannot read {path}: {error.strerror or error}")
-        except ValueError as error:
-            parser.error(str(error))
+        except (ValueError, TypeError) as error:
+            parser.error(f"{path}: {error}")
     c1, c2 = curves
     try:
         field = map_curves(c1, c2, args.method, closed=args.closed, n=args.n, reverse=args.reverse,
@@ -97,8 +97,14 @@ def main(argv=None) -> int:
         "map", help="map curve C1 onto curve C2 (CSV files of x,y rows) and write the displacement field",
         description="Map curve C1 (time t) onto curve C2 (time t + dt). Curves: CSV files of x,y rows, with an "
                     "optional header. Prints the vector count and quality measures to stderr.")
-    mapping.add_argument("c1", metavar="C1", help="CSV file of the curve at time t")
-    mapping.add_argument("c2", metavar="C2", help="CSV file of the curve at time t + dt")
+    mapping.add_argument("c1", metavar="C1", help="the curve at time t: a CSV file, or a 2D mask (PNG, TIFF, .npy)")
+    mapping.add_argument("c2", metavar="C2", help="the curve at time t + dt, likewise")
+    mapping.add_argument("--spacing", type=_spacing, default=None, metavar="S[,S]",
+                         help="pixel size of masks: one value, or rows,columns (default: what the file states, "
+                              "else 1)")
+    mapping.add_argument("--label", type=int, default=None, help="the object's value in a label image")
+    mapping.add_argument("--smooth", type=_length, default=0.0, metavar="W",
+                         help="Gaussian width (physical units) applied to masks before contouring (default 0)")
     mapping.add_argument("--method", default="auto", choices=CURVE_METHODS, help="the algorithm (default: auto)")
     closed = mapping.add_mutually_exclusive_group()
     closed.add_argument("--closed", dest="closed", action="store_true", default=True,
@@ -127,6 +133,40 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("morphomap: interrupted", file=sys.stderr)
         return 130
+
+
+IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".npy")
+
+
+def _is_image(path: str) -> bool:
+    return path.lower().endswith(IMAGE_SUFFIXES)
+
+
+def _read_frame(path: str, args):
+    """The boundary of the mask in an image file, at --spacing, else the file's, else 1 (said)."""
+    from .images import read_image
+    from .masks import boundary_from_mask
+
+    data, stated = read_image(path)
+    if data.ndim != 2:
+        raise ValueError(f"a {data.ndim}D image (shape {data.shape}): the command line maps 2D masks; "
+                         "contour stacks into surfaces and use morphomap.map_surfaces")
+    if args.spacing is not None:
+        spacing, source = tuple(args.spacing), "--spacing"
+    elif stated is not None:
+        spacing, source = tuple(float(v) for v in stated), "the file"
+    else:
+        spacing, source = (1.0,), "no spacing in the file, none given"
+    print(f"{path}: pixel spacing {' x '.join(f'{v:g}' for v in spacing)} ({source})", file=sys.stderr)
+    return boundary_from_mask(data, spacing if len(spacing) > 1 else spacing[0], label=args.label,
+                              smooth=args.smooth)
+
+
+def _spacing(text: str) -> tuple:
+    values = tuple(_length(part, positive=True) for part in text.split(","))
+    if len(values) not in (1, 2):
+        raise argparse.ArgumentTypeError(f"expected one length or two (rows,columns), got {text!r}")
+    return values
 
 
 def _positive(text: str) -> int:
