@@ -3,7 +3,9 @@
 // segfaults in the triangulation's insert_in_hole (fuzz seeds 5002 and 5022, among others; the
 // same pair meshes at other element sizes). A crash there must not take the caller's process down,
 // so the mesh is made in a forked child and sent back through a pipe; a child that dies becomes a
-// GeometryError, and the caller may try again with other settings.
+// GeometryError, and the caller may try again with other settings. The child runs the
+// single-threaded mesher only (no TBB, no Python, no Embree), allocating through glibc's malloc,
+// which its fork handlers leave usable however many threads the parent has.
 #include "shell_mesh.hpp"
 
 #include <morphomap/errors.hpp>
