@@ -328,8 +328,8 @@ class Tracer {
 // seed 5038: 218 s) or crashes (seed 5022). A patch: a face of S1 with all three corners within
 // `tolerance` of S2.
 void require_no_touching_patch(const Points3Ref& source_vertices, const FacesRef& source_faces,
-                               const Points3Ref& target_vertices, const FacesRef& target_faces, double tolerance) {
-  const Vector distance = SurfaceIndex(target_vertices, target_faces).closest_points(source_vertices).distances;
+                               const SurfaceIndex& target_index, double tolerance) {
+  const Vector distance = target_index.closest_points(source_vertices).distances;
   Index touching = 0;
   for (Index f = 0; f < source_faces.rows(); ++f) {
     bool near = true;
@@ -369,7 +369,8 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
   if (nesting == detail::Nesting::disjoint) {
     throw InvalidInput("s2: diffusion mapping needs surfaces that overlap (these lie apart)");
   }
-  require_no_touching_patch(source_vertices, source_faces, target_vertices, target_faces,
+  const SurfaceIndex target_index(target_vertices, target_faces);
+  require_no_touching_patch(source_vertices, source_faces, target_index,
                             kTouchFraction * std::min(source.mean_edge, target.mean_edge));
   std::unique_ptr<detail::CrossingRegion> crossing;
   if (nesting == detail::Nesting::crossing) {
@@ -484,7 +485,7 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
   if (!reached.empty()) {
     Points3 queries(static_cast<Index>(reached.size()), 3);
     for (std::size_t k = 0; k < reached.size(); ++k) queries.row(static_cast<Index>(k)) = exits.row(reached[k]);
-    const SurfaceHits ends = SurfaceIndex(target_vertices, target_faces).closest_points(queries);
+    const SurfaceHits ends = target_index.closest_points(queries);
     for (std::size_t k = 0; k < reached.size(); ++k) solution.ends.row(reached[k]) = ends.points.row(static_cast<Index>(k));
   }
   if (options.keep_streamlines) {

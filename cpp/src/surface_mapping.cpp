@@ -13,6 +13,7 @@
 
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -28,9 +29,11 @@ struct Surface {
 };
 
 // Vectors from the vertices of `source` to `target` (queried through `target_index`, built from
-// it) with one basic algorithm.
+// it) with one basic algorithm. Diffusion's fold repair also queries `source`: through
+// `source_index` where the caller has one, else through one built here.
 DisplacementField3 basic(MapMethod method, const Surface& source, const Surface& target,
-                         const SurfaceIndex& target_index, double mesh_size) {
+                         const SurfaceIndex& target_index, double mesh_size,
+                         const SurfaceIndex* source_index = nullptr) {
   DisplacementField3 field;
   field.starts = source.vertices;
   field.faces = source.faces;
@@ -63,8 +66,13 @@ DisplacementField3 basic(MapMethod method, const Surface& source, const Surface&
       const Points3 on_target = target_index.closest_points(found).points;
       for (std::size_t k = 0; k < rows.size(); ++k) field.ends.row(rows[k]) = on_target.row(k);
       // The streamlines do not cross; the few slivers their discrete form flips are repaired.
-      detail::unfold(field.starts, field.ends, field.faces, source.vertices, source.faces,
-                     SurfaceIndex(source.vertices, source.faces), target.vertices, target.faces, target_index);
+      std::unique_ptr<SurfaceIndex> own_index;
+      if (source_index == nullptr) {
+        own_index = std::make_unique<SurfaceIndex>(source.vertices, source.faces);
+        source_index = own_index.get();
+      }
+      detail::unfold(field.starts, field.ends, field.faces, source.vertices, source.faces, *source_index,
+                     target.vertices, target.faces, target_index);
       field.methods.assign(field.size(), Method::diffusion);
       break;
     }
@@ -105,8 +113,9 @@ DisplacementField3 automatic(const Surface& source, const Surface& target, const
   }
   for (const bool backwards : {true, false}) {
     try {
-      DisplacementField3 field = backwards ? flipped(basic(MapMethod::diffusion, target, source, source_index, mesh_size))
-                                           : basic(MapMethod::diffusion, source, target, target_index, mesh_size);
+      DisplacementField3 field =
+          backwards ? flipped(basic(MapMethod::diffusion, target, source, source_index, mesh_size, &target_index))
+                    : basic(MapMethod::diffusion, source, target, target_index, mesh_size, &source_index);
       if (complete(field)) return field;
     } catch (const GeometryError&) {
     } catch (const InvalidInput&) {  // surfaces whose region diffusion cannot mesh (they coincide in part, say)

@@ -158,8 +158,7 @@ def _read_frame(path: str, args):
     else:
         spacing, source = (1.0,), "no spacing in the file, none given"
     print(f"{path}: pixel spacing {' x '.join(f'{v:g}' for v in spacing)} ({source})", file=sys.stderr)
-    return boundary_from_mask(data, spacing if len(spacing) > 1 else spacing[0], label=args.label,
-                              smooth=args.smooth)
+    return boundary_from_mask(data, spacing, label=args.label, smooth=args.smooth)
 
 
 def _spacing(text: str) -> tuple:

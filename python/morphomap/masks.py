@@ -12,6 +12,7 @@ import numbers
 import numpy as np
 
 from ._validate import as_length
+from .curves import signed_area
 
 
 def _spacing_2d(spacing) -> tuple[float, float]:
@@ -56,11 +57,6 @@ def _require_one_object(pixels: np.ndarray, name: str) -> None:
         shown = ", ".join(str(s) for s in sizes[:6]) + (", ..." if count > 6 else "")
         raise ValueError(f"{name}: {count} separate objects ({shown} pixels), as when debris is segmented "
                          f"with the organ: keep one (scipy.ndimage.label) or pass a label image and label=")
-
-
-def _signed_area(points: np.ndarray) -> float:
-    x, y = points[:, 0], points[:, 1]
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
 
 
 def boundary_from_mask(mask, spacing=1.0, *, label=None, smooth=0.0) -> np.ndarray:
@@ -108,7 +104,7 @@ def boundary_from_mask(mask, spacing=1.0, *, label=None, smooth=0.0) -> np.ndarr
     contours = [c for c in measure.find_contours(image, 0.5) if len(c) >= 4]
     if not contours:
         raise ValueError(f"mask: the object vanishes when smoothed by {sigma}: use a smaller smooth=")
-    outer = max(contours, key=lambda c: abs(_signed_area(c)))
+    outer = max(contours, key=lambda c: abs(signed_area(c)))
     # The other contours are holes (inside the outer one) unless smoothing cut a neck.
     apart = [c for c in contours if c is not outer and not measure.points_in_poly(c[:1], outer)[0]]
     if apart:
@@ -116,6 +112,6 @@ def boundary_from_mask(mask, spacing=1.0, *, label=None, smooth=0.0) -> np.ndarr
                          f"use a smaller smooth=")
     rows_columns = outer[:-1]  # the outer boundary, without its repeated end point
     curve = np.column_stack([(rows_columns[:, 1] - pad) * column_spacing, (rows_columns[:, 0] - pad) * row_spacing])
-    if _signed_area(curve) < 0:
+    if signed_area(curve) < 0:
         curve = curve[::-1]
     return np.ascontiguousarray(curve)
