@@ -4,6 +4,8 @@
 // surfaces are first cut where they cross.
 #include "shell_mesh.hpp"
 
+#include "surface_mesh.hpp"
+
 #include <morphomap/errors.hpp>
 
 #include <CGAL/AABB_traits.h>
@@ -42,7 +44,6 @@ namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Point = Kernel::Point_3;
-using SurfaceMesh = CGAL::Surface_mesh<Point>;
 using Domain = CGAL::Polyhedral_complex_mesh_domain_3<Kernel, SurfaceMesh>;
 using Triangulation = CGAL::Mesh_triangulation_3<Domain, CGAL::Default, CGAL::Sequential_tag>::type;
 using C3t3 = CGAL::Mesh_complex_3_in_triangulation_3<Triangulation, Domain::Corner_index, Domain::Curve_index>;
@@ -54,26 +55,6 @@ using PointTree = Neighbour::Tree;
 using Triangles = std::vector<Kernel::Triangle_3>;
 using SoupTree =
     CGAL::AABB_tree<CGAL::AABB_traits<Kernel, CGAL::AABB_triangle_primitive<Kernel, Triangles::const_iterator>>>;
-
-// The referenced vertices and the faces as a Surface_mesh (the caller checked that it is closed).
-SurfaceMesh to_surface_mesh(const Points3Ref& vertices, const FacesRef& faces) {
-  SurfaceMesh mesh;
-  std::vector<SurfaceMesh::Vertex_index> handle(vertices.rows());
-  std::vector<char> used(vertices.rows(), 0);
-  for (Index f = 0; f < faces.rows(); ++f) {
-    for (int i = 0; i < 3; ++i) used[faces(f, i)] = 1;
-  }
-  for (Index v = 0; v < vertices.rows(); ++v) {
-    if (used[v]) handle[v] = mesh.add_vertex(Point(vertices(v, 0), vertices(v, 1), vertices(v, 2)));
-  }
-  for (Index f = 0; f < faces.rows(); ++f) {
-    if (mesh.add_face(handle[faces(f, 0)], handle[faces(f, 1)], handle[faces(f, 2)]) ==
-        SurfaceMesh::null_face()) {
-      throw GeometryError("a surface is not a manifold triangle mesh");
-    }
-  }
-  return mesh;
-}
 
 // Target edge length at a point: graded from the size at each surface with the distance to it,
 // the distance estimated by the nearest surface vertex (cheap: Mesh_3 asks very often). Mesh_3

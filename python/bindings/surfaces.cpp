@@ -5,6 +5,7 @@
 
 #include <morphomap/errors.hpp>
 #include <morphomap/quality.hpp>
+#include <morphomap/remesh.hpp>
 #include <morphomap/surface_mapping.hpp>
 #include <morphomap/surface_queries.hpp>
 
@@ -111,4 +112,17 @@ void bind_surfaces(py::module_& m) {
       },
       py::arg("starts"), py::arg("ends"), py::arg("faces"), py::arg("v1"), py::arg("f1"), py::arg("v2"),
       py::arg("f2"), Release());
+
+  m.def(
+      "remesh_surface",
+      [](const Points3Ref& vertices, const FacesRef& faces, double edge_length, int iterations) {
+        TriangleSurface surface;
+        InterruptGuard interruptible;
+        {
+          py::gil_scoped_release release;
+          surface = remesh_surface(vertices, faces, edge_length, iterations);
+        }
+        return py::make_tuple(std::move(surface.vertices), std::move(surface.faces));
+      },
+      py::arg("vertices"), py::arg("faces"), py::arg("edge_length"), py::arg("iterations"));
 }

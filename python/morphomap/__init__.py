@@ -25,7 +25,8 @@ from .field import DisplacementField
 from .images import Image, read_image
 from .io import load_example, read_curve, read_field, write_curve, write_field
 from .mapping import map_curves
-from .masks import boundary_from_mask
+from .masks import boundary_from_mask, surface_from_mask
+from .mesh_files import read_surface, write_surface
 from .plot import plot_field
 from .quality import CurveQuality, SurfaceQuality, quality
 from .queries import CurveHits, CurveIndex, closest_points, line_intersections
@@ -76,12 +77,15 @@ __all__ = [
     "read_curve",
     "read_field",
     "read_image",
+    "read_surface",
     "resample",
     "signed_area",
     "solve_diffusion",
     "solve_diffusion_3d",
     "split_components",
+    "surface_from_mask",
     "surface_normals",
     "write_curve",
     "write_field",
+    "write_surface",
 ]

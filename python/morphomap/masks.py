@@ -15,22 +15,25 @@ from ._validate import as_length
 from .curves import signed_area
 
 
-def _spacing_2d(spacing) -> tuple[float, float]:
-    """(row, column) spacing from one number or a pair in the image's axis order."""
+_AXES = {2: "(rows, columns)", 3: "(sz, sy, sx)"}
+
+
+def _spacing(spacing, ndim: int) -> tuple[float, ...]:
+    """The spacing along each axis, in the image's axis order, from one number or one per axis."""
     values = np.atleast_1d(np.asarray(spacing, dtype=object))
-    if values.ndim != 1 or len(values) not in (1, 2):
-        raise ValueError(f"spacing: expected one number or one per axis (rows, columns), got {spacing!r}")
+    if values.ndim != 1 or len(values) not in (1, ndim):
+        raise ValueError(f"spacing: expected one number or one per axis {_AXES[ndim]}, got {spacing!r}")
     lengths = [as_length(v, "spacing", 1.0) for v in values]
-    return (lengths[0], lengths[0]) if len(lengths) == 1 else (lengths[0], lengths[1])
+    return tuple(lengths * ndim) if len(lengths) == 1 else tuple(lengths)
 
 
-def _object(mask, label, name: str) -> np.ndarray:
+def _object(mask, label, name: str, ndim: int = 2) -> np.ndarray:
     """The boolean image of the one object to contour: ``label``'s pixels, or the foreground."""
     array = np.asarray(mask)
     if array.dtype == object or not (np.issubdtype(array.dtype, np.integer) or array.dtype == bool):
         raise TypeError(f"{name}: expected a boolean mask or an integer label image, got dtype {array.dtype}")
-    if array.ndim != 2:
-        raise ValueError(f"{name}: expected a 2D image, got shape {array.shape}")
+    if array.ndim != ndim:
+        raise ValueError(f"{name}: expected a {ndim}D image, got shape {array.shape}")
     if label is None:
         labels = np.unique(array[array != 0])
         if len(labels) > 1 and array.dtype != bool:
@@ -48,14 +51,16 @@ def _object(mask, label, name: str) -> np.ndarray:
 def _require_one_object(pixels: np.ndarray, name: str) -> None:
     from scipy import ndimage
 
-    # 4-connectivity: marching squares at level 0.5 separates pixels that touch only at a corner.
+    # Face connectivity (4 in 2D, 6 in 3D): marching squares and cubes at level 0.5 separate
+    # pixels that touch only at a corner or an edge.
     components, count = ndimage.label(pixels)
+    unit = "pixels" if pixels.ndim == 2 else "voxels"
     if count == 0:
-        raise ValueError(f"{name}: has no foreground pixel")
+        raise ValueError(f"{name}: has no foreground {unit[:-1]}")
     if count > 1:
         sizes = np.sort(np.bincount(components.ravel())[1:])[::-1]
         shown = ", ".join(str(s) for s in sizes[:6]) + (", ..." if count > 6 else "")
-        raise ValueError(f"{name}: {count} separate objects ({shown} pixels), as when debris is segmented "
+        raise ValueError(f"{name}: {count} separate objects ({shown} {unit}), as when debris is segmented "
                          f"with the organ: keep one (scipy.ndimage.label) or pass a label image and label=")
 
 
@@ -92,7 +97,7 @@ def boundary_from_mask(mask, spacing=1.0, *, label=None, smooth=0.0) -> np.ndarr
     from skimage import measure
 
     pixels = _object(mask, label, "mask")
-    row_spacing, column_spacing = _spacing_2d(spacing)
+    row_spacing, column_spacing = _spacing(spacing, 2)
     sigma = as_length(smooth, "smooth", 0.0, allow_zero=True)
     _require_one_object(pixels, "mask")
     # Padding closes the contour of an object touching the border; with smoothing it must hold
@@ -115,3 +120,71 @@ def boundary_from_mask(mask, spacing=1.0, *, label=None, smooth=0.0) -> np.ndarr
     if signed_area(curve) < 0:
         curve = curve[::-1]
     return np.ascontiguousarray(curve)
+
+
+def surface_from_mask(volume, spacing=(1.0, 1.0, 1.0), *, label=None, smooth=0.0, edge_length=None):
+    """The boundary of the object in a 3D mask, as a closed, remeshed triangle surface.
+
+    Parameters
+    ----------
+    volume : (z, y, x) bool or integer array
+        A binary mask (non-zero is the object) or a label image (``label`` picks the object),
+        indexed ``[z, y, x]`` as microscopy stacks are. The object must be one piece
+        (6-connected); cavities inside it are filled: the surface is the outer boundary.
+    spacing : float or (sz, sy, sx)
+        Voxel size in the volume's axis order (a confocal stack is often 0.5 x 0.5 x 2 um).
+    label : int, optional
+        The value of the object in a label image; required when the image holds several labels.
+    smooth : float
+        Width (standard deviation, in physical units) of a Gaussian applied to the mask before
+        contouring; 0 contours the voxels as they are.
+    edge_length : float, optional
+        Target edge length of the triangles, in physical units; by default the largest voxel
+        size.
+
+    Returns
+    -------
+    trimesh.Trimesh
+        Watertight, one component, normals outwards, vertices (x, y, z) in physical units with
+        **x = column * sx, y = row * sy, z = slice * sz**. The level 0.5 of the (smoothed) mask
+        by marching cubes (scikit-image), then remeshed to near-uniform triangles of
+        ``edge_length`` by CGAL's isotropic remeshing in the C++ core, which projects every
+        vertex back onto the marching-cubes surface: the raw surface's slivers (which make
+        3D quality measures explode) are gone, its shape is kept. Unsmoothed, that shape is the
+        voxels' staircase: a ball of radius 20 um in a 0.5 x 0.5 x 2 um stack gives its volume
+        within 1% but an area 3.5% too large; ``smooth`` of the finest voxel size (0.5 um)
+        brings the area within 2% too.
+    """
+    import trimesh
+    from scipy import ndimage
+    from skimage import measure
+
+    from . import _core
+
+    voxels = _object(volume, label, "volume", ndim=3)
+    step = _spacing(spacing, 3)
+    sigma = as_length(smooth, "smooth", 0.0, allow_zero=True)
+    edge = as_length(edge_length, "edge_length", max(step))
+    _require_one_object(voxels, "volume")
+    voxels = ndimage.binary_fill_holes(voxels)
+    # Padding closes the surface of an object touching the border; with smoothing it must hold
+    # the Gaussian's reach too.
+    pad = 1 + int(np.ceil(4 * sigma / min(step)))
+    image = np.pad(voxels.astype(float), pad)
+    if sigma > 0:
+        image = ndimage.gaussian_filter(image, tuple(sigma / h for h in step))
+    if image.max() <= 0.5:
+        raise ValueError(f"volume: the object vanishes when smoothed by {sigma}: use a smaller smooth=")
+    vertices, faces, _, _ = measure.marching_cubes(image, 0.5, spacing=step)
+    # (z, y, x) -> (x, y, z); the padding is taken off so that coordinates are the volume's.
+    vertices = np.ascontiguousarray(vertices[:, ::-1] - np.array(step[::-1]) * pad)
+    faces = np.ascontiguousarray(faces, dtype=np.int64)
+    pieces = trimesh.Trimesh(vertices, faces, process=False).split(only_watertight=False)
+    if len(pieces) > 1:
+        raise ValueError(f"smooth: a Gaussian of width {sigma} splits the object into {len(pieces)} pieces: "
+                         f"use a smaller smooth=")
+    vertices, faces = _core.remesh_surface(vertices, faces, edge, 5)
+    surface = trimesh.Trimesh(vertices, faces, process=False)
+    if surface.volume < 0:
+        surface.invert()
+    return surface

@@ -11,6 +11,7 @@
 #include <morphomap/laplace3d.hpp>
 #include <morphomap/mapping.hpp>
 #include <morphomap/quality.hpp>
+#include <morphomap/remesh.hpp>
 #include <morphomap/resample.hpp>
 #include <morphomap/surface_mapping.hpp>
 #include <morphomap/surface_queries.hpp>
