@@ -67,9 +67,49 @@ def test_map_reads_masks(tmp_path):
     assert done.returncode == 0 and "pixel spacing 1 x 1 (--spacing)" in done.stderr
     done = subprocess.run([sys.executable, "-m", "morphomap", "map", str(tmp_path / "t0.tif"), str(tmp_path / "t1.tif"),
                            "--spacing", "1,2,3"], capture_output=True, text=True)
-    assert done.returncode == 2 and "--spacing" in done.stderr
-    # A stack is refused with the way out.
+    assert done.returncode == 2 and "spacing: expected one number or one per axis (rows, columns)" in done.stderr
+    # A stack and a mask are not two of a kind.
     np.save(tmp_path / "stack.npy", np.ones((3, 4, 4), np.uint8))
     done = subprocess.run([sys.executable, "-m", "morphomap", "map", str(tmp_path / "stack.npy"), str(tmp_path / "t1.tif")],
                           capture_output=True, text=True)
-    assert done.returncode == 2 and "a 3D image" in done.stderr and "map_surfaces" in done.stderr
+    assert done.returncode == 2 and "is a surface but" in done.stderr and "is a curve" in done.stderr
+
+
+def test_map_reads_stacks_and_mesh_files(tmp_path):
+    # Two frames of a growing ball as an ImageJ stack (2 x 0.5 x 0.5 um voxels, stated in the file)
+    # and a .npy (spacing given): the field is written with its faces, so that read_field and
+    # quality round-trip, and drawn in 3D; a mesh file maps the same way.
+    import numpy as np
+    import tifffile
+
+    z, y, x = np.indices((20, 60, 60))
+    def ball(radius):
+        return ((x - 30) * 0.5) ** 2 + ((y - 30) * 0.5) ** 2 + ((z - 10) * 2.0) ** 2 <= radius**2
+
+    tifffile.imwrite(tmp_path / "t0.tif", ball(8.0).astype(np.uint8), imagej=True, resolution=(2.0, 2.0),
+                     metadata={"spacing": 2.0, "unit": "um", "axes": "ZYX"})
+    np.save(tmp_path / "t1.npy", ball(11.0))
+    out, plot = tmp_path / "field.csv", tmp_path / "field.png"
+    command = [sys.executable, "-m", "morphomap", "map", str(tmp_path / "t0.tif"), str(tmp_path / "t1.npy")]
+    done = subprocess.run([*command, "--spacing", "2,0.5,0.5", "--method", "normal", "-o", str(out), "--plot", str(plot)],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert "voxel spacing 2 x 0.5 x 0.5 (--spacing)" in done.stderr and "folds 0" in done.stderr
+    field = mm.read_field(out)
+    assert field.dim == 3 and field.faces is not None and field.valid.all()
+    lengths = np.linalg.norm(field.vectors, axis=1)
+    assert abs(np.median(lengths) - 3.0) < 0.5  # radius 8 -> 11 um
+    s0 = mm.surface_from_mask(ball(8.0), (2.0, 0.5, 0.5))
+    s1 = mm.surface_from_mask(ball(11.0), (2.0, 0.5, 0.5))
+    assert mm.quality(field, s0, s1).folds == 0
+    assert plot.stat().st_size > 10_000
+    mm.write_surface(tmp_path / "t1.ply", s1)
+    done = subprocess.run([sys.executable, "-m", "morphomap", "map", str(tmp_path / "t0.tif"), str(tmp_path / "t1.ply"),
+                           "--method", "normal", "-o", str(out)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert "voxel spacing 2 x 0.5 x 0.5 (the file)" in done.stderr
+    # Curve options are refused for surfaces, and uniform is a 2D method.
+    done = subprocess.run([*command, "--spacing", "2,0.5,0.5", "--n", "50"], capture_output=True, text=True)
+    assert done.returncode == 2 and "--n applies to curves, not to surfaces" in done.stderr
+    done = subprocess.run([*command, "--spacing", "2,0.5,0.5", "--method", "uniform"], capture_output=True, text=True)
+    assert done.returncode == 2 and "method" in done.stderr

@@ -72,6 +72,29 @@ def test_field_round_trip_with_nan_rows(tmp_path):
     assert np.array_equal(back.valid, field.valid) and list(back.method) == methods
 
 
+def test_3d_field_round_trips_with_its_faces(tmp_path):
+    import trimesh
+
+    s1 = trimesh.creation.icosphere(2)
+    s2 = s1.copy().apply_scale(1.4)
+    field = mm.map_surfaces(s1, s2, "normal")
+    mm.write_field(tmp_path / "f.csv", field)
+    text = (tmp_path / "f.csv").read_text().splitlines()
+    assert text[0] == "start_x,start_y,start_z,end_x,end_y,end_z,valid,method"
+    assert text[len(field) + 1] == "face_a,face_b,face_c" and len(text) == len(field) + 2 + len(field.faces)
+    back = mm.read_field(tmp_path / "f.csv")
+    assert np.array_equal(back.starts, field.starts) and np.array_equal(back.ends, field.ends)
+    assert np.array_equal(back.faces, field.faces)
+    assert mm.quality(back, s1, s2) == mm.quality(field, s1, s2)
+    # Faces must index the vectors, and a 2D field has none.
+    (tmp_path / "bad.csv").write_text("\n".join(text[: len(field) + 2] + ["0,1,99999"]) + "\n")
+    with pytest.raises(ValueError, match="bad.csv: faces: vertex index 99999"):
+        mm.read_field(tmp_path / "bad.csv")
+    (tmp_path / "flat.csv").write_text("start_x,start_y,end_x,end_y,valid,method\n0,0,1,1,1,normal\nface_a,face_b,face_c\n0,0,0\n")
+    with pytest.raises(ValueError, match="a 2D field has no faces"):
+        mm.read_field(tmp_path / "flat.csv")
+
+
 def test_field_of_a_mapping_round_trips(tmp_path):
     c1, c2 = mm.load_example("circle_ellipse")
     field = mm.map_curves(c1, c2, "normal", reverse=True)

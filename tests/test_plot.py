@@ -78,3 +78,32 @@ def test_new_figure_when_no_axes_and_bad_arguments():
         mm.plot_field((c1, c2), c1, c2)
     with pytest.raises(ValueError, match="c2: expected shape"):
         mm.plot_field(field, c1, np.zeros((4, 3)))
+
+
+def test_y_down_draws_the_image_way_up():
+    c1, c2 = circle(40, 1.0), circle(60, 2.0)
+    field = mm.map_curves(c1, c2, "normal")
+    assert not mm.plot_field(field, c1, c2, ax=axes()).yaxis_inverted()
+    assert mm.plot_field(field, c1, c2, ax=axes(), y_down=True).yaxis_inverted()
+
+
+def test_3d_field_draws_two_surfaces_and_coloured_vectors():
+    import trimesh
+    from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
+
+    s1 = trimesh.creation.icosphere(2)
+    s2 = s1.copy().apply_scale(1.5)
+    field = mm.map_surfaces(s1, s2, "normal")
+    ax = mm.plot_field(field, s1, s2, ax=Figure().add_subplot(projection="3d"), title="normal")
+    assert sum(isinstance(c, Poly3DCollection) for c in ax.collections) == 2
+    [lines] = [c for c in ax.collections if isinstance(c, Line3DCollection)]
+    assert len(lines.get_array()) == len(field)
+    assert np.allclose(lines.get_array(), 0.5, atol=0.01)  # unit icosphere to radius 1.5
+    # Many vectors are thinned to keep the surfaces visible; a 2D axes is refused.
+    big = trimesh.creation.icosphere(5)
+    field = mm.map_surfaces(big, big.copy().apply_scale(1.2), "normal")
+    ax = mm.plot_field_3d(field, big, big.copy().apply_scale(1.2), ax=Figure().add_subplot(projection="3d"))
+    [lines] = [c for c in ax.collections if isinstance(c, Line3DCollection)]
+    assert len(lines.get_array()) == mm.plot.MAX_VECTORS_3D < len(field)
+    with pytest.raises(TypeError, match="ax: expected a 3D axes"):
+        mm.plot_field_3d(field, big, big, ax=axes())

@@ -27,7 +27,7 @@ from .io import load_example, read_curve, read_field, write_curve, write_field
 from .mapping import map_curves
 from .masks import boundary_from_mask, surface_from_mask
 from .mesh_files import read_surface, write_surface
-from .plot import plot_field
+from .plot import plot_field, plot_field_3d
 from .quality import CurveQuality, SurfaceQuality, quality
 from .queries import CurveHits, CurveIndex, closest_points, line_intersections
 from .surfaces import SurfaceHits, SurfaceIndex, map_surfaces, surface_normals
@@ -73,6 +73,7 @@ __all__ = [
     "overlap_area",
     "perimeter",
     "plot_field",
+    "plot_field_3d",
     "quality",
     "read_curve",
     "read_field",

@@ -80,3 +80,26 @@ def as_length(value, name: str, default: float, *, allow_zero: bool = False) -> 
     if not np.isfinite(value) or value < 0 or (value == 0 and not allow_zero):
         raise ValueError(f"{name}: must be a finite number {'>=' if allow_zero else '>'} 0, got {value}")
     return value
+
+
+def as_faces(value, name: str, vertex_count: int) -> np.ndarray:
+    """Return ``value`` as a C-contiguous int64 (F, 3) array of indices into ``vertex_count`` vertices."""
+    if isinstance(value, (str, bytes)) or value is None:
+        raise TypeError(f"{name}: expected an integer array of shape (F, 3), got {type(value).__name__}")
+    try:
+        array = np.asarray(value)
+    except (ValueError, TypeError) as error:
+        raise ValueError(f"{name}: cannot be read as an array of shape (F, 3): {error}") from None
+    if array.dtype == bool or not np.issubdtype(array.dtype, np.integer):
+        if array.size == 0 and array.dtype == np.float64:  # an empty list
+            array = array.astype(np.int64)
+        else:
+            raise TypeError(f"{name}: expected integer vertex indices, got an array of dtype {array.dtype}")
+    if array.ndim != 2 or array.shape[1] != 3:
+        raise ValueError(f"{name}: expected shape (F, 3), got {array.shape}")
+    if array.size:
+        low, high = array.min(), array.max()
+        if low < 0 or high >= vertex_count:
+            bad = low if low < 0 else high
+            raise ValueError(f"{name}: vertex index {int(bad)} is outside 0..{vertex_count - 1}")
+    return np.ascontiguousarray(array, dtype=np.int64)

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 import sys
 
+import numpy as np
+
 
 def _info(args) -> int:
     import morphomap
@@ -31,51 +33,70 @@ def _demo(args) -> int:
 
 
 def _map(args, parser) -> int:
-    import numpy as np
-
     import morphomap
 
-    from .io import read_curve, write_field
-    from .mapping import map_curves
-    from .quality import quality
-
-    curves = []
+    frames = []
     for path in (args.c1, args.c2):
         try:
-            curves.append(_read_frame(path, args) if _is_image(path) else read_curve(path))
+            frames.append(_read_frame(path, args))
         except OSError as error:
             parser.error(f"cannot read {path}: {error.strerror or error}")
         except (ValueError, TypeError) as error:
             parser.error(f"{path}: {error}")
-    c1, c2 = curves
+    (c1, from_image), (c2, _) = frames
+    surfaces = [not isinstance(frame, np.ndarray) for frame in (c1, c2)]
+    if surfaces[0] != surfaces[1]:
+        parser.error(f"{args.c1} is a {'surface' if surfaces[0] else 'curve'} but {args.c2} is a "
+                     f"{'surface' if surfaces[1] else 'curve'}: map two of a kind")
     try:
-        field = map_curves(c1, c2, args.method, closed=args.closed, n=args.n, reverse=args.reverse,
-                           transform=args.transform, split=args.split, contact_tolerance=args.contact_tolerance,
-                           mesh_size=args.mesh_size)
+        if surfaces[0]:
+            for option, given in _CURVE_ONLY.items():
+                if given(args):
+                    parser.error(f"{option} applies to curves, not to surfaces")
+            field = morphomap.map_surfaces(c1, c2, args.method, reverse=args.reverse, mesh_size=args.mesh_size)
+            q = morphomap.quality(field, c1, c2)
+        else:
+            field = morphomap.map_curves(c1, c2, args.method, closed=args.closed, n=args.n, reverse=args.reverse,
+                                         transform=args.transform, split=args.split,
+                                         contact_tolerance=args.contact_tolerance, mesh_size=args.mesh_size)
+            q = morphomap.quality(field, c1, c2, closed=args.closed)
     except (ValueError, TypeError, morphomap.InvalidInput, morphomap.GeometryError) as error:
         parser.error(f"cannot map {args.c1} onto {args.c2} with --method {args.method}: {error}")
-    q = quality(field, c1, c2, closed=args.closed)
+    title = f"{args.method}: QM1 {q.qm1:.4g}  QM2 {q.qm2:.4g}  QM {q.qm:.4g}"
     try:
-        write_field(sys.stdout if args.output == "-" else args.output, field)
+        morphomap.write_field(sys.stdout if args.output == "-" else args.output, field)
         if args.plot:
             from matplotlib.figure import Figure
 
-            from .plot import plot_field, save_figure
+            from .plot import plot_field, plot_field_3d, save_figure
 
             fig = Figure(figsize=(7, 7), layout="constrained")
-            plot_field(field, c1, c2, ax=fig.subplots(), closed=args.closed,
-                       title=f"{args.method}: QM1 {q.qm1:.4g}  QM2 {q.qm2:.4g}  QM {q.qm:.4g}")
+            if field.dim == 3:
+                plot_field_3d(field, c1, c2, ax=fig.add_subplot(projection="3d"), title=title)
+            else:
+                plot_field(field, c1, c2, ax=fig.subplots(), closed=args.closed, title=title, y_down=from_image)
             save_figure(fig, args.plot, dpi=100)
     except OSError as error:
         parser.error(f"cannot write {error.filename}: {error.strerror or error}")
     names, counts = np.unique(field.method, return_counts=True)
     used = ", ".join(f"{name} {count}" for name, count in zip(names, counts))
+    defects = f"folds {q.folds}" if field.dim == 3 else f"crossings {q.crossings}"
     summary = (f"{len(field)} vectors, {int(field.valid.sum())} valid, {int((~field.valid).sum())} missed ({used}); "
-               f"QM1 {q.qm1:.4g}  QM2 {q.qm2:.4g}  QM {q.qm:.4g}  crossings {q.crossings}")
+               f"QM1 {q.qm1:.4g}  QM2 {q.qm2:.4g}  QM {q.qm:.4g}  {defects}")
     where = "" if args.output == "-" else f"; field written to {args.output}"
     where += f", plot to {args.plot}" if args.plot else ""
     print(summary + where, file=sys.stderr)
     return 0
+
+
+# Options of `map` that only curves have, and how to tell that one was given.
+_CURVE_ONLY = {
+    "--n": lambda args: args.n is not None,
+    "--open": lambda args: not args.closed,
+    "--transform": lambda args: args.transform,
+    "--no-split": lambda args: not args.split,
+    "--contact-tolerance": lambda args: args.contact_tolerance is not None,
+}
 
 
 def main(argv=None) -> int:
@@ -94,17 +115,20 @@ def main(argv=None) -> int:
                       help="folder to write into (default: ./morphomap-demo)")
     demo.set_defaults(run=_demo)
     mapping = commands.add_parser(
-        "map", help="map curve C1 onto curve C2 (CSV files of x,y rows) and write the displacement field",
-        description="Map curve C1 (time t) onto curve C2 (time t + dt). Curves: CSV files of x,y rows, with an "
-                    "optional header. Prints the vector count and quality measures to stderr.")
-    mapping.add_argument("c1", metavar="C1", help="the curve at time t: a CSV file, or a 2D mask (PNG, TIFF, .npy)")
-    mapping.add_argument("c2", metavar="C2", help="the curve at time t + dt, likewise")
-    mapping.add_argument("--spacing", type=_spacing, default=None, metavar="S[,S]",
-                         help="pixel size of masks: one value, or rows,columns (default: what the file states, "
-                              "else 1)")
+        "map", help="map boundary C1 onto boundary C2 (curves, surfaces or masks) and write the displacement field",
+        description="Map boundary C1 (time t) onto boundary C2 (time t + dt): curves (CSV files of x,y rows, "
+                    "with an optional header) or 2D masks (PNG, TIFF, .npy), or closed surfaces (STL, PLY, OBJ, "
+                    "OFF) or 3D stacks (TIFF, .npy). Prints the vector count and quality measures to stderr.")
+    mapping.add_argument("c1", metavar="C1", help="the boundary at time t: a CSV curve, a mesh file, a 2D mask or a 3D stack")
+    mapping.add_argument("c2", metavar="C2", help="the boundary at time t + dt, likewise")
+    mapping.add_argument("--spacing", type=_spacing, default=None, metavar="S[,S[,S]]",
+                         help="pixel or voxel size of masks: one value, or one per axis (rows,columns; sz,sy,sx) "
+                              "(default: what the file states, else 1)")
     mapping.add_argument("--label", type=int, default=None, help="the object's value in a label image")
     mapping.add_argument("--smooth", type=_length, default=0.0, metavar="W",
                          help="Gaussian width (physical units) applied to masks before contouring (default 0)")
+    mapping.add_argument("--edge-length", type=lambda text: _length(text, positive=True), default=None, metavar="L",
+                         help="triangle edge length of surfaces from 3D stacks (default: the largest voxel size)")
     mapping.add_argument("--method", default="auto", choices=CURVE_METHODS, help="the algorithm (default: auto)")
     closed = mapping.add_mutually_exclusive_group()
     closed.add_argument("--closed", dest="closed", action="store_true", default=True,
@@ -123,9 +147,11 @@ def main(argv=None) -> int:
     mapping.add_argument("--mesh-size", type=lambda text: _length(text, positive=True), default=None, metavar="H",
                          help="the diffusion mesh size (default: from the gap between the curves)")
     mapping.add_argument("-o", "--output", default="-", metavar="FIELD.csv",
-                         help="where to write the field (columns start_x,start_y,end_x,end_y,valid,method); "
+                         help="where to write the field (columns start_x,start_y,end_x,end_y,valid,method; 3D: "
+                              "with start_z, end_z and the faces); "
                               "default: standard output")
-    mapping.add_argument("--plot", metavar="FIELD.png", help="also draw the field into this image file")
+    mapping.add_argument("--plot", metavar="FIELD.png",
+                         help="also draw the field into this image file (2D masks: y down, as the image looks)")
     mapping.set_defaults(run=lambda args: _map(args, mapping))
     args = parser.parse_args(argv)
     try:
@@ -143,28 +169,38 @@ def _is_image(path: str) -> bool:
 
 
 def _read_frame(path: str, args):
-    """The boundary of the mask in an image file, at --spacing, else the file's, else 1 (said)."""
+    """``(frame, from_image)``: the curve (CSV) or surface (mesh file) in ``path``, or the boundary of
+    the mask in an image file (2D: a curve, 3D stack: a surface) at --spacing, else the file's,
+    else 1 (said on stderr)."""
     from .images import read_image
-    from .masks import boundary_from_mask
+    from .io import read_curve
+    from .masks import boundary_from_mask, surface_from_mask
+    from .mesh_files import SURFACE_SUFFIXES, read_surface
 
+    if path.lower().endswith(SURFACE_SUFFIXES):
+        return read_surface(path), False
+    if not _is_image(path):
+        return read_curve(path), False
     data, stated = read_image(path)
-    if data.ndim != 2:
-        raise ValueError(f"a {data.ndim}D image (shape {data.shape}): the command line maps 2D masks; "
-                         "contour stacks into surfaces and use morphomap.map_surfaces")
+    if data.ndim not in (2, 3):
+        raise ValueError(f"a {data.ndim}D image (shape {data.shape}): expected a 2D mask or a 3D stack")
     if args.spacing is not None:
         spacing, source = tuple(args.spacing), "--spacing"
     elif stated is not None:
         spacing, source = tuple(float(v) for v in stated), "the file"
     else:
         spacing, source = (1.0,), "no spacing in the file, none given"
-    print(f"{path}: pixel spacing {' x '.join(f'{v:g}' for v in spacing)} ({source})", file=sys.stderr)
-    return boundary_from_mask(data, spacing, label=args.label, smooth=args.smooth)
+    unit = "pixel" if data.ndim == 2 else "voxel"
+    print(f"{path}: {unit} spacing {' x '.join(f'{v:g}' for v in spacing)} ({source})", file=sys.stderr)
+    if data.ndim == 2:
+        return boundary_from_mask(data, spacing, label=args.label, smooth=args.smooth), True
+    return surface_from_mask(data, spacing, label=args.label, smooth=args.smooth, edge_length=args.edge_length), True
 
 
 def _spacing(text: str) -> tuple:
     values = tuple(_length(part, positive=True) for part in text.split(","))
-    if len(values) not in (1, 2):
-        raise argparse.ArgumentTypeError(f"expected one length or two (rows,columns), got {text!r}")
+    if len(values) not in (1, 2, 3):
+        raise argparse.ArgumentTypeError(f"expected one length, or one per axis (rows,columns or sz,sy,sx), got {text!r}")
     return values
 
 

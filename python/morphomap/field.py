@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validate import as_points
+from ._validate import as_faces, as_points
 
 #: Names of the basic algorithms; ``reverse_`` ones ran from C2 to C1 and were flipped.
 BASIC_METHODS = ("minimal_distance", "normal", "diffusion", "uniform")
@@ -62,7 +62,7 @@ class DisplacementField:
         self._starts = _frozen(starts)
         self._ends = _frozen(ends)
         self._method = _frozen(method.astype(f"<U{max(map(len, METHOD_NAMES))}"))
-        self._faces = None if faces is None else _frozen(np.asarray(faces, dtype=np.int64))
+        self._faces = None if faces is None else _frozen(as_faces(faces, "faces", len(starts)))
 
     @classmethod
     def _from_core(cls, starts, ends, methods, faces=None):

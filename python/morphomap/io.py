@@ -2,7 +2,9 @@
 
 Curve files hold one point per row, ``x,y``, with an optional header row (``x,y``). Field files have
 the header ``start_x,start_y,end_x,end_y,valid,method`` (``start_z`` and ``end_z`` after the ``y``
-columns of a 3D field); rows without a target hold ``nan`` and ``valid`` 0.
+columns of a 3D field); rows without a target hold ``nan`` and ``valid`` 0. A 3D field's faces (the
+triangles of its start points, which its quality measures need) follow as a second table, headed
+``face_a,face_b,face_c``, of row indices into the vectors.
 
 Blank lines and lines starting with ``#`` are skipped. Values are separated by commas; a file
 without commas may separate them by tabs or spaces instead. Numbers are written with ``repr`` so
@@ -27,6 +29,7 @@ EXAMPLES = ("circle_ellipse", "kidney")
 
 _FIELD_2D = ("start_x", "start_y", "end_x", "end_y", "valid", "method")
 _FIELD_3D = ("start_x", "start_y", "start_z", "end_x", "end_y", "end_z", "valid", "method")
+_FACES = ("face_a", "face_b", "face_c")
 
 
 def _rows(path):
@@ -126,7 +129,9 @@ def write_field(path, field: DisplacementField) -> None:
     """Write a displacement field as CSV: ``start_x,start_y,end_x,end_y,valid,method`` per vector.
 
     Missing coordinates are written as ``nan``; ``valid`` is 1 or 0. 3D fields get ``start_z`` and
-    ``end_z`` columns (their faces are not written). ``path``: a file name or an open text file.
+    ``end_z`` columns, and their faces follow as a second table (``face_a,face_b,face_c``), so that
+    :func:`read_field` and :func:`morphomap.quality` round-trip. ``path``: a file name or an open
+    text file; a file name is written atomically.
     """
     if not isinstance(field, DisplacementField):
         raise TypeError(f"field: expected a DisplacementField, got {type(field).__name__}")
@@ -137,6 +142,10 @@ def write_field(path, field: DisplacementField) -> None:
                                              field.valid.tolist(), field.method.tolist()):
             values = ",".join(repr(float(v)) for v in (*start, *end))
             handle.write(f"{values},{int(valid)},{method}\n")
+        if field.faces is not None:
+            handle.write(",".join(_FACES) + "\n")
+            for a, b, c in field.faces.tolist():
+                handle.write(f"{a},{b},{c}\n")
 
 
 def read_field(path) -> DisplacementField:
@@ -158,6 +167,12 @@ def read_field(path) -> DisplacementField:
     index = {column: header.index(column) for column in wanted}
     coordinates = [column for column in wanted if column not in ("valid", "method")]
     dim = len(coordinates) // 2
+    face_rows = []
+    split = next((k for k, (_, cells) in enumerate(rows) if [c.lower() for c in cells] == list(_FACES)), None)
+    if split is not None:
+        if dim != 3:
+            raise ValueError(f"{name}: line {rows[split][0]}: a 2D field has no faces")
+        rows, face_rows = rows[:split], rows[split + 1 :]
     values = np.empty((len(rows) - 1, 2 * dim))
     methods = []
     for i, (number, cells) in enumerate(rows[1:]):
@@ -171,8 +186,16 @@ def read_field(path) -> DisplacementField:
         if (valid in ("1", "true")) != bool(np.isfinite(values[i]).all()):
             raise ValueError(f"{name}: line {number}: valid is {cells[index['valid']]} but the coordinates say otherwise")
         methods.append(cells[index["method"]])
+    faces = None
+    if split is not None:
+        faces = np.empty((len(face_rows), 3), dtype=np.int64)
+        for i, (number, cells) in enumerate(face_rows):
+            if len(cells) != 3 or not all(cell.lstrip("-").isdigit() for cell in cells):
+                raise ValueError(f"{name}: line {number}: expected three vector indices face_a,face_b,face_c")
+            faces[i] = [int(cell) for cell in cells]
     try:
-        return DisplacementField(values[:, :dim], values[:, dim:], np.asarray(methods, dtype=str).reshape(-1))
+        return DisplacementField(values[:, :dim], values[:, dim:], np.asarray(methods, dtype=str).reshape(-1),
+                                 faces)
     except ValueError as error:
         raise ValueError(f"{name}: {error}") from None
 

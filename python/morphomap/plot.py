@@ -28,23 +28,26 @@ def _headless() -> bool:
     return not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
 
 
-def _new_axes():
+def _new_axes(projection=None):
     import matplotlib
 
     if _headless():
         matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    _, ax = plt.subplots(figsize=(6, 6))
-    return ax
+    figure = plt.figure(figsize=(6, 6))
+    return figure.add_subplot(projection=projection)
 
 
 def _closed_line(points, closed):
     return np.vstack([points, points[:1]]) if closed and len(points) else points
 
 
-def plot_field(field, c1, c2, ax=None, *, closed=True, title=None):
-    """Draw a 2D displacement field between two curves; returns the matplotlib ``Axes``.
+def plot_field(field, c1, c2, ax=None, *, closed=True, title=None, y_down=False):
+    """Draw a displacement field between two curves (2D) or surfaces (3D); returns the ``Axes``.
+
+    3D fields are drawn by :func:`plot_field_3d` (``c1``, ``c2`` are then the surfaces); the rest
+    of this describes 2D.
 
     C1 is drawn in green, C2 in blue, the vectors as thin red lines with a small dot at each end
     point (as in the paper's figures). Vectors that cross another vector
@@ -65,14 +68,18 @@ def plot_field(field, c1, c2, ax=None, *, closed=True, title=None):
     closed : bool
         Draw the curves closed.
     title : str, optional
+    y_down : bool
+        Draw y growing downwards, the way an image looks: for curves from
+        :func:`morphomap.boundary_from_mask`, whose y is the image row.
 
     Artists added: two lines (C1, C2) and two collections (the vectors, their end points), plus one
     collection for crossing vectors and one for misses when there are any.
     """
     if not isinstance(field, DisplacementField):
         raise TypeError(f"field: expected a DisplacementField, got {type(field).__name__}")
-    if field.dim != 2:
-        raise ValueError(f"field: expected a 2D field, got {field.dim}D")
+    if field.dim == 3:
+        return plot_field_3d(field, c1, c2, ax=ax, title=title)
+    y_down = as_flag(y_down, "y_down")
     c1 = as_points(c1, "c1")
     c2 = as_points(c2, "c2")
     closed = as_flag(closed, "closed")
@@ -106,7 +113,63 @@ def plot_field(field, c1, c2, ax=None, *, closed=True, title=None):
                    label=f"no target ({int(missed.sum())})")
     ax.set_aspect("equal", adjustable="datalim")
     ax.autoscale_view()
+    if y_down:
+        ax.invert_yaxis()
     ax.legend(loc="best", fontsize="small", framealpha=0.8)
+    if title is not None:
+        ax.set_title(title)
+    return ax
+
+
+#: At most this many vectors are drawn in 3D (evenly chosen): more only hide the surfaces.
+MAX_VECTORS_3D = 4000
+
+
+def plot_field_3d(field, s1, s2, ax=None, *, title=None):
+    """Draw a 3D displacement field between two surfaces; returns the matplotlib 3D ``Axes``.
+
+    S1 is drawn in translucent green, S2 in translucent blue, the vectors as lines coloured by their
+    length (a colour bar gives the scale; at most :data:`MAX_VECTORS_3D` of them, evenly chosen, so
+    that the surfaces stay visible), start points without a target as grey ``x``. Equal aspect.
+
+    ``s1``, ``s2``: ``trimesh.Trimesh`` or ``(vertices, faces)`` pairs; ``ax``: a 3D axes
+    (``projection="3d"``), by default a new figure.
+    """
+    from mpl_toolkits.mplot3d.art3d import Line3DCollection
+
+    from .surfaces import as_surface
+
+    if not isinstance(field, DisplacementField):
+        raise TypeError(f"field: expected a DisplacementField, got {type(field).__name__}")
+    if field.dim != 3:
+        raise ValueError(f"field: expected a 3D field, got {field.dim}D")
+    surfaces = [as_surface(s1, "s1"), as_surface(s2, "s2")]
+    if title is not None and not isinstance(title, str):
+        raise TypeError(f"title: expected a string, got {type(title).__name__}")
+    if ax is None:
+        ax = _new_axes("3d")
+    elif not hasattr(ax, "plot_trisurf"):
+        raise TypeError("ax: expected a 3D axes (projection='3d')")
+    for (vertices, faces), colour, name in zip(surfaces, (C1_COLOUR, C2_COLOUR), ("$S_1$", "$S_2$")):
+        ax.plot_trisurf(*vertices.T, triangles=faces, color=colour, alpha=0.18, linewidth=0, label=name)
+    valid = np.flatnonzero(field.valid)
+    shown = valid[np.linspace(0, len(valid) - 1, min(len(valid), MAX_VECTORS_3D)).astype(int)] if len(valid) else valid
+    lengths = np.linalg.norm(field.vectors[shown], axis=1)
+    lines = Line3DCollection(np.stack([field.starts[shown], field.ends[shown]], axis=1), cmap="viridis",
+                             linewidths=0.8, label=f"vectors ({len(valid)}" + (f", {len(shown)} drawn)" if len(shown) < len(valid) else ")"))
+    lines.set_array(lengths)
+    ax.add_collection3d(lines)
+    ax.figure.colorbar(lines, ax=ax, shrink=0.6, label="vector length")
+    missed = ~field.valid & np.isfinite(field.starts).all(axis=1)
+    if missed.any():
+        ax.scatter(*field.starts[missed].T, marker="x", s=14, color=MISS_COLOUR, label=f"no target ({int(missed.sum())})")
+    everything = np.vstack([surfaces[0][0], surfaces[1][0]])
+    low, high = everything.min(axis=0), everything.max(axis=0)
+    centre, half = (low + high) / 2, (high - low).max() / 2
+    ax.set(xlim=(centre[0] - half, centre[0] + half), ylim=(centre[1] - half, centre[1] + half),
+           zlim=(centre[2] - half, centre[2] + half), xlabel="x", ylabel="y", zlabel="z")
+    ax.set_box_aspect((1, 1, 1))
+    ax.legend(loc="upper left", fontsize="small", framealpha=0.8)
     if title is not None:
         ax.set_title(title)
     return ax

@@ -7,33 +7,10 @@ from typing import NamedTuple
 import numpy as np
 
 from . import _core
-from ._validate import as_choice, as_flag, as_length, as_points
+from ._validate import as_choice, as_faces, as_flag, as_length, as_points
 from .field import DisplacementField
 
 SURFACE_METHODS = ("minimal_distance", "normal", "diffusion", "auto")
-
-
-def as_faces(value, name: str, vertex_count: int) -> np.ndarray:
-    """Return ``value`` as a C-contiguous int64 (F, 3) array of indices into ``vertex_count`` vertices."""
-    if isinstance(value, (str, bytes)) or value is None:
-        raise TypeError(f"{name}: expected an integer array of shape (F, 3), got {type(value).__name__}")
-    try:
-        array = np.asarray(value)
-    except (ValueError, TypeError) as error:
-        raise ValueError(f"{name}: cannot be read as an array of shape (F, 3): {error}") from None
-    if array.dtype == bool or not np.issubdtype(array.dtype, np.integer):
-        if array.size == 0 and array.dtype == np.float64:  # an empty list
-            array = array.astype(np.int64)
-        else:
-            raise TypeError(f"{name}: expected integer vertex indices, got an array of dtype {array.dtype}")
-    if array.ndim != 2 or array.shape[1] != 3:
-        raise ValueError(f"{name}: expected shape (F, 3), got {array.shape}")
-    if array.size:
-        low, high = array.min(), array.max()
-        if low < 0 or high >= vertex_count:
-            bad = low if low < 0 else high
-            raise ValueError(f"{name}: vertex index {int(bad)} is outside 0..{vertex_count - 1}")
-    return np.ascontiguousarray(array, dtype=np.int64)
 
 
 def as_surface(value, name: str) -> tuple[np.ndarray, np.ndarray]:
