@@ -54,6 +54,25 @@ def test_demo_runs_every_algorithm_and_writes_everything(tmp_path):
     assert int(normal[6]) > 0
     assert str((tmp_path / "out").resolve()) in out
     assert (tmp_path / "out" / "quality.csv").read_text().count("\n") == 1 + len(EXAMPLES) * 13
+    # From images: the frames are TIFFs a user can map again with the command line; every field of
+    # the table is on disk with its figure and its measures hold when recomputed.
+    images = tmp_path / "out" / "images"
+    assert mm.read_image(images / "figure12_t0.tif").spacing == (2.0, 0.5, 0.5)
+    for pair, method in [("kidney", "normal"), ("kidney", "diffusion"), ("kidney", "auto"),
+                         *[(name, m) for name, methods in demo.STACKS.items() for m in methods]]:
+        kind = "masks" if pair == "kidney" else "stacks"
+        [row] = [cells for cells in table if cells[:3] == [f"{pair}_{kind}", method, "plain"]]
+        field = mm.read_field(images / f"{pair}_{method}.csv")
+        assert (images / f"{pair}_{method}.png").stat().st_size > 10_000
+        if kind == "masks":
+            b1, b2 = mm.read_curve(images / "kidney_c1.csv"), mm.read_curve(images / "kidney_c2.csv")
+            defects = mm.quality(field, b1, b2).crossings
+        else:
+            b1, b2 = mm.read_surface(images / f"{pair}_s1.ply"), mm.read_surface(images / f"{pair}_s2.ply")
+            defects = mm.quality(field, b1, b2).folds
+        assert int(row[6]) == defects and int(row[7]) == int((~field.valid).sum())
+        if method in ("diffusion", "auto"):
+            assert defects == 0  # the bijective methods and the workflow on real-looking frames
 
 
 def test_demo_default_folder_and_failures(monkeypatch):

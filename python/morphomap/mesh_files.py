@@ -60,15 +60,21 @@ def read_surface(path):
 
 def write_surface(path, mesh) -> None:
     """Write a closed triangle surface (a ``trimesh.Trimesh`` or a ``(vertices, faces)`` pair) to an
-    STL, PLY, OBJ or OFF file, chosen by the suffix. STL and PLY are written binary, in float32 as
-    those formats usually are; OBJ and OFF as text with 15 decimals. The write is atomic: a failed
-    or interrupted write leaves the previous file as it was."""
+    STL, PLY, OBJ or OFF file, chosen by the suffix: PLY binary with double coordinates (exact),
+    OBJ and OFF as text with 15 decimals, STL binary in float32 as the format defines it. The
+    write is atomic: a failed or interrupted write leaves the previous file as it was."""
     import trimesh
 
     suffix = _suffix(path, "path")
     vertices, faces = as_surface(mesh, "mesh")
     surface = trimesh.Trimesh(np.asarray(vertices), np.asarray(faces), process=False)
-    # STL and PLY (binary) store float32; the text formats get every digit that matters.
-    options = {"digits": 15} if suffix in (".obj", ".off") else {}
     with atomic_path(path) as temporary:
-        surface.export(temporary, file_type=suffix[1:], **options)
+        if suffix == ".ply":
+            # trimesh writes PLY coordinates as float32; meshio keeps doubles.
+            import meshio
+
+            mesh = meshio.Mesh(surface.vertices, [("triangle", surface.faces.astype(np.int32))])
+            meshio.write(temporary, mesh, file_format="ply", binary=True)
+        else:
+            # The text formats get every digit that matters; STL is float32 by its definition.
+            surface.export(temporary, file_type=suffix[1:], **({"digits": 15} if suffix != ".stl" else {}))
