@@ -33,24 +33,25 @@ def check_ball(surface, r, tolerance):
 def test_a_ball_in_an_anisotropic_stack():
     # The issue's bar: r = 20 um in a 0.5 x 0.5 x 2 um stack, volume within 1%, area within 2%,
     # every vertex within half the coarsest voxel of the sphere, minimum angle above 20 degrees
-    # on 99% of the faces; at the default edge length (the coarsest voxel), smoothed by the
-    # finest voxel size.
+    # on 99% of the faces; at the default edge length (the coarsest voxel), unsmoothed and
+    # smoothed.
     r = 20.0
     volume = ball((26, 100, 100), CENTRE, r, SPACING)
-    surface = mm.surface_from_mask(volume, SPACING, smooth=0.5)
-    lengths = check_ball(surface, r, 0.5 * max(SPACING))
-    assert 0.8 < np.median(lengths) / 2.0 < 1.25
-    # Smoothed by one micron and with finer triangles the surface is still the sphere.
+    for smooth in (0.0, 0.5):
+        surface = mm.surface_from_mask(volume, SPACING, smooth=smooth)
+        lengths = check_ball(surface, r, 0.5 * max(SPACING))
+        assert 0.8 < np.median(lengths) / 2.0 < 1.25
+    # With triangles as fine as the voxels, an unsmoothed surface follows their staircase: the
+    # volume and the distances hold, the area comes out too large (measured: 11%), as the
+    # docstring says; smoothed by one micron it is the sphere again.
+    raw = mm.surface_from_mask(volume, SPACING, edge_length=1.0)
+    assert abs(raw.volume / (4 / 3 * np.pi * r**3) - 1) < 0.01
+    assert np.abs(np.linalg.norm(raw.vertices - CENTRE, axis=1) - r).max() <= 0.5 * max(SPACING)
+    assert 0.05 < raw.area / (4 * np.pi * r**2) - 1 < 0.15
     finer = mm.surface_from_mask(volume, SPACING, smooth=1.0, edge_length=1.0)
     lengths = check_ball(finer, r, 0.5 * max(SPACING))
     assert len(finer.faces) > 3 * len(surface.faces)
     assert 0.8 < np.median(lengths) / 1.0 < 1.25
-    # Unsmoothed, the surface follows the voxels' staircase: the volume and the distances hold,
-    # the area comes out too large (measured: 3.5%), as the docstring says.
-    raw = mm.surface_from_mask(volume, SPACING)
-    assert abs(raw.volume / (4 / 3 * np.pi * r**3) - 1) < 0.01
-    assert np.abs(np.linalg.norm(raw.vertices - CENTRE, axis=1) - r).max() <= 0.5 * max(SPACING)
-    assert 0.02 < raw.area / (4 * np.pi * r**2) - 1 < 0.05
 
 
 def test_coordinates_follow_the_axes():

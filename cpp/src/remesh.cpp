@@ -12,6 +12,8 @@
 #include <CGAL/Polygon_mesh_processing/orientation.h>
 #include <CGAL/Polygon_mesh_processing/remesh.h>
 #include <CGAL/Polygon_mesh_processing/repair_degeneracies.h>
+#include <CGAL/Polygon_mesh_processing/repair_self_intersections.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/boost/graph/helpers.h>
 
 #include <cmath>
@@ -69,6 +71,17 @@ TriangleSurface remesh_surface(const Points3Ref& vertices, const FacesRef& trian
   // All rounds in one call: each call projects onto the surface it was given, so rounds in
   // separate calls would drift away from the input surface.
   PMP::isotropic_remeshing(faces(mesh), edge_length, mesh, CGAL::parameters::number_of_iterations(iterations));
+  detail::check_interrupt();
+  // Relaxation and projection onto a staircase of voxels (the terraces of a coarse z spacing)
+  // can turn a few triangles over; CGAL repairs such spots locally.
+  if (PMP::does_self_intersect<CGAL::Parallel_if_available_tag>(mesh)) {
+    PMP::experimental::remove_self_intersections(mesh);
+    mesh.collect_garbage();
+    if (!CGAL::is_closed(mesh) || PMP::does_self_intersect<CGAL::Parallel_if_available_tag>(mesh)) {
+      throw GeometryError("surface: remeshing at edge length " + std::to_string(edge_length) +
+                          " makes the surface intersect itself: try a smaller edge_length or smooth the mask");
+    }
+  }
   detail::check_interrupt();
   mesh.collect_garbage();
   if (PMP::is_outward_oriented(mesh) != outward) PMP::reverse_face_orientations(mesh);

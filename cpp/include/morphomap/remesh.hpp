@@ -13,7 +13,9 @@ struct TriangleSurface {
 // remeshing: edge splits, collapses, flips and tangential relaxation, every new vertex projected
 // back onto the input surface). The input must be a closed, consistently oriented manifold
 // triangle mesh in one piece; it may hold the slivers and zero-area faces of marching cubes,
-// which are removed first. The orientation is kept. `iterations` >= 1 remeshing rounds.
+// which are removed first. The orientation is kept. `iterations` >= 1 remeshing rounds. The
+// result does not intersect itself: spots where remeshing turned triangles over are repaired
+// (CGAL's remove_self_intersections), and GeometryError is thrown if that fails.
 // Throws InvalidInput naming "surface", "edge_length" or "iterations".
 TriangleSurface remesh_surface(const Points3Ref& vertices, const FacesRef& faces, double edge_length,
                                int iterations = 5);
