@@ -16,6 +16,7 @@ void bind_transform(py::module_& m);
 void bind_quality(py::module_& m);
 void bind_surfaces(py::module_& m);
 void bind_diffusion3d(py::module_& m);
+void bind_field_at(py::module_& m);
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "morphomap C++ core (use the morphomap package, not this module)";
@@ -47,4 +48,5 @@ PYBIND11_MODULE(_core, m) {
   bind_quality(m);
   bind_surfaces(m);
   bind_diffusion3d(m);
+  bind_field_at(m);
 }

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validate import as_faces, as_points
+from ._validate import as_faces, as_flag, as_points
 
 #: Names of the basic algorithms; ``reverse_`` ones ran from C2 to C1 and were flipped.
 BASIC_METHODS = ("minimal_distance", "normal", "diffusion", "uniform")
@@ -36,13 +36,18 @@ class DisplacementField:
         from C2 back to C1 (the paper's reverse mapping, e.g. ``"reverse_diffusion"``).
     faces : (F, 3) int64 or None
         3D only: the connectivity of the start points.
+    source : (N, 2) float or None
+        2D: the source curve C1 the field was made from (as given to :func:`map_curves`), which
+        :meth:`at` places points on; None for a field read from a file.
+    closed : bool
+        2D: whether ``source`` is a closed curve.
 
     Vectors are in the order of the points of the curve or surface the algorithm mapped from.
     """
 
-    __slots__ = ("_starts", "_ends", "_method", "_faces")
+    __slots__ = ("_starts", "_ends", "_method", "_faces", "_source", "_closed")
 
-    def __init__(self, starts, ends, method, faces=None):
+    def __init__(self, starts, ends, method, faces=None, *, source=None, closed=True):
         starts = np.asarray(starts)
         dim = starts.shape[1] if starts.ndim == 2 else 2
         starts = as_points(starts, "starts", dim, allow_nan=True)
@@ -63,11 +68,13 @@ class DisplacementField:
         self._ends = _frozen(ends)
         self._method = _frozen(method.astype(f"<U{max(map(len, METHOD_NAMES))}"))
         self._faces = None if faces is None else _frozen(as_faces(faces, "faces", len(starts)))
+        self._source = None if source is None else _frozen(as_points(source, "source", 2))
+        self._closed = as_flag(closed, "closed")
 
     @classmethod
-    def _from_core(cls, starts, ends, methods, faces=None):
+    def _from_core(cls, starts, ends, methods, faces=None, **source):
         codes, names = methods  # the core's codes and its table of their names
-        return cls(starts, ends, np.asarray(names)[np.asarray(codes, dtype=np.int64)], faces)
+        return cls(starts, ends, np.asarray(names)[np.asarray(codes, dtype=np.int64)], faces, **source)
 
     @property
     def starts(self) -> np.ndarray:
@@ -92,6 +99,51 @@ class DisplacementField:
     @property
     def faces(self):
         return self._faces
+
+    @property
+    def source(self):
+        return self._source
+
+    @property
+    def closed(self) -> bool:
+        return self._closed
+
+    def at(self, points, source=None, *, closed=None, return_distances=False):
+        """The displacement at ``points`` of the source boundary, whatever made the field.
+
+        2D: each point is projected onto the source curve C1 and placed by arc length among the
+        valid start points (placed on C1 the same way); the vectors of its two neighbours are
+        interpolated linearly in arc length (round the end on a closed curve; before the first or
+        after the last start of an open curve, that start's vector). The vectors' order does not
+        matter, so reverse and crossing fields work too. ``source`` defaults to the curve the
+        field was made from (:attr:`source`); a field read from a file needs it passed.
+
+        3D: each point is projected onto the start triangles (:attr:`faces` over :attr:`starts`)
+        and the vectors at the corners are interpolated with the barycentric weights.
+
+        Exact at the start points. Points off the boundary are projected onto it: with
+        ``return_distances=True`` the distances ``(P,)`` come back too, so that a solver's nodes
+        can be checked. Rows are NaN where the neighbouring vectors have no target.
+
+        Returns ``(P, d)`` float (and ``(P,)`` distances).
+        """
+        from . import _core
+
+        points = as_points(points, "points", self.dim)
+        if self.dim == 3:
+            if self._faces is None:
+                raise ValueError("field: a 3D field needs its faces to interpolate (read it from a CSV with faces)")
+            displacements, distances = _core.displacement_at_3d(self._starts, self._ends, self._faces, points)
+        else:
+            if source is None:
+                source = self._source
+                closed = self._closed if closed is None else closed
+            if source is None:
+                raise ValueError("source: this field does not know the curve it was made from: pass source=C1")
+            closed = as_flag(True if closed is None else closed, "closed")
+            displacements, distances = _core.displacement_at_2d(
+                self._starts, self._ends, as_points(source, "source", 2), closed, points)
+        return (displacements, distances) if return_distances else displacements
 
     @property
     def dim(self) -> int:

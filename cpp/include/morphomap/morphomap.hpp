@@ -6,6 +6,7 @@
 #include <morphomap/curve_queries.hpp>
 #include <morphomap/errors.hpp>
 #include <morphomap/field.hpp>
+#include <morphomap/field_at.hpp>
 #include <morphomap/interrupt.hpp>
 #include <morphomap/laplace.hpp>
 #include <morphomap/laplace3d.hpp>
