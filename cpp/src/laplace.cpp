@@ -38,14 +38,7 @@ Vector solve_potential(const detail::RegionMesh& mesh, const std::vector<char>& 
   return detail::solve_dirichlet(mesh.vertices.rows(), mesh.triangles, kind, [&](Index t) {
     Vec2 p[3];
     for (int i = 0; i < 3; ++i) p[i] = mesh.vertices.row(mesh.triangles(t, i)).transpose();
-    const double area2 = cross(p[1] - p[0], p[2] - p[0]);
-    Eigen::Matrix3d k;
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) {
-        k(i, j) = (p[(i + 2) % 3] - p[(i + 1) % 3]).dot(p[(j + 2) % 3] - p[(j + 1) % 3]) / (2.0 * area2);
-      }
-    }
-    return k;
+    return detail::triangle_stiffness(p);
   }, false);
 }
 

@@ -65,23 +65,11 @@ SurfaceFacts check_surface(const Points3Ref& vertices, const FacesRef& faces, co
   return facts;
 }
 
-// Gradients of the barycentric coordinates of a tetrahedron (rows) and its signed volume.
-double gradients(const Points3& vertices, const Tetrahedra& tets, Index t, Eigen::Matrix<double, 4, 3>& g) {
-  const Vec3 p0 = vertices.row(tets(t, 0)).transpose();
-  Eigen::Matrix3d edges;
-  for (int i = 0; i < 3; ++i) edges.col(i) = vertices.row(tets(t, i + 1)).transpose() - p0;
-  const double det = edges.determinant();
-  const Eigen::Matrix3d inverse = edges.inverse();
-  g.bottomRows(3) = inverse;
-  g.row(0) = -inverse.colwise().sum();
-  return det / 6.0;
-}
-
 // The P1 solution on the tetrahedra: local stiffness volume * grad phi_i . grad phi_j.
 Vector solve_potential(const detail::ShellMesh& mesh, const std::vector<char>& kind) {
   return detail::solve_dirichlet(mesh.vertices.rows(), mesh.tetrahedra, kind, [&](Index t) {
     Eigen::Matrix<double, 4, 3> g;
-    const double volume = std::abs(gradients(mesh.vertices, mesh.tetrahedra, t, g));
+    const double volume = std::abs(detail::tetrahedron_gradients(mesh.vertices, mesh.tetrahedra, t, g));
     return Eigen::Matrix4d(volume * g * g.transpose());
   }, true);
 }
@@ -106,7 +94,7 @@ class Tracer {
     element_flow_.assign(tets, Vec3::Constant(kNaN));
     Eigen::Matrix<double, 4, 3> g;
     for (Index t = 0; t < tets; ++t) {
-      const double volume = std::abs(gradients(mesh.vertices, mesh.tetrahedra, t, g));
+      const double volume = std::abs(detail::tetrahedron_gradients(mesh.vertices, mesh.tetrahedra, t, g));
       Vec3 flow = Vec3::Zero();
       bool at_crossing = false;
       for (int i = 0; i < 4; ++i) {

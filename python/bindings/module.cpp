@@ -17,6 +17,7 @@ void bind_quality(py::module_& m);
 void bind_surfaces(py::module_& m);
 void bind_diffusion3d(py::module_& m);
 void bind_field_at(py::module_& m);
+void bind_extend(py::module_& m);
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "morphomap C++ core (use the morphomap package, not this module)";
@@ -49,4 +50,5 @@ PYBIND11_MODULE(_core, m) {
   bind_surfaces(m);
   bind_diffusion3d(m);
   bind_field_at(m);
+  bind_extend(m);
 }

@@ -21,6 +21,7 @@ from .curves import (
 )
 from .diffusion import DiffusionSolution, solve_diffusion
 from .diffusion3d import ShellDiffusionSolution, solve_diffusion_3d
+from .extend import InteriorField, extend_field
 from .field import DisplacementField
 from .images import Image, read_image
 from .io import load_example, read_curve, read_field, write_curve, write_field
@@ -49,6 +50,7 @@ __all__ = [
     "DisplacementField",
     "GeometryError",
     "Image",
+    "InteriorField",
     "InvalidInput",
     "ShellDiffusionSolution",
     "Similarity",
@@ -63,6 +65,7 @@ __all__ = [
     "count_crossings",
     "crossing_pairs",
     "curve_intersections",
+    "extend_field",
     "is_self_intersecting",
     "line_intersections",
     "load_example",

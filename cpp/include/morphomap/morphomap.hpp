@@ -5,6 +5,7 @@
 #include <morphomap/curve_geometry.hpp>
 #include <morphomap/curve_queries.hpp>
 #include <morphomap/errors.hpp>
+#include <morphomap/extend.hpp>
 #include <morphomap/field.hpp>
 #include <morphomap/field_at.hpp>
 #include <morphomap/interrupt.hpp>

@@ -18,5 +18,6 @@ using Tetrahedra = Eigen::Matrix<Index, Eigen::Dynamic, 4, Eigen::RowMajor>;
 using Points2Ref = Eigen::Ref<const Points2>;
 using Points3Ref = Eigen::Ref<const Points3>;
 using FacesRef = Eigen::Ref<const Faces>;
+using TetrahedraRef = Eigen::Ref<const Tetrahedra>;
 
 }  // namespace morphomap

@@ -1,0 +1,110 @@
+"""The interior displacement (harmonic extension) against exact answers."""
+
+import numpy as np
+import pytest
+import trimesh
+from scipy.spatial import Delaunay
+
+import morphomap as mm
+from conftest import circle
+
+A2, B2 = np.array([[1.2, 0.3], [-0.1, 0.9]]), np.array([0.3, -0.2])
+A3, B3 = np.array([[1.1, 0.2, 0.0], [-0.1, 0.9, 0.1], [0.3, 0.0, 1.2]]), np.array([0.1, 0.2, -0.3])
+
+
+def rotation(angle):
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s], [s, c]])
+
+
+def disc_mesh(c1, interior=300, seed=1):
+    """A Delaunay mesh of the convex curve's vertices and random points inside: its boundary is C1."""
+    rng = np.random.default_rng(seed)
+    r, t = 0.95 * np.sqrt(rng.random(interior)), rng.uniform(0, 2 * np.pi, interior)
+    points = np.vstack([c1, np.column_stack([r * np.cos(t), r * np.sin(t)])])
+    return points, Delaunay(points).simplices
+
+
+@pytest.mark.parametrize("A, b", [(A2, B2), (1.7 * rotation(0.6), np.array([2.0, -1.0]))])
+def test_affine_boundary_maps_extend_to_the_same_map_in_2d(A, b):
+    c1 = circle(120)
+    field = mm.DisplacementField(c1, c1 @ A.T + b, "normal", source=c1)
+    for mesh in (None, disc_mesh(c1)):
+        interior = mm.extend_field(field, mesh=mesh)
+        expected = interior.points @ A.T + b - interior.points
+        assert np.abs(interior.displacement - expected).max() < 1e-10
+        assert interior.inverted == 0 and interior.boundary_distance < 1e-12
+        assert interior.min_jacobian == pytest.approx(np.linalg.det(A), rel=1e-9)
+
+
+def test_affine_boundary_maps_extend_to_the_same_map_in_3d():
+    s1 = trimesh.creation.icosphere(2)
+    rng = np.random.default_rng(2)
+    inside = rng.normal(size=(400, 3))
+    inside *= (0.9 * rng.random(400) ** (1 / 3) / np.linalg.norm(inside, axis=1))[:, None]
+    points = np.vstack([s1.vertices, inside])
+    cells = Delaunay(points).simplices
+    field = mm.DisplacementField(s1.vertices, s1.vertices @ A3.T + B3, "normal", faces=s1.faces)
+    interior = mm.extend_field(field, mesh=(points, cells))
+    assert np.abs(interior.displacement - (points @ A3.T + B3 - points)).max() < 1e-10
+    assert interior.inverted == 0 and interior.boundary_distance < 1e-12
+
+
+def test_concentric_circles_give_the_radial_field_inside():
+    # Diffusion between r = 1 and r = 2: u = x on the boundary to the mapping's accuracy, and the
+    # harmonic extension of u = x is u = x inside.
+    c1 = circle(200)
+    field = mm.map_curves(c1, 2 * c1, "diffusion")
+    interior = mm.extend_field(field, mesh_size=0.05)
+    boundary_error = np.abs(field.vectors - field.starts).max()
+    assert np.abs(interior.displacement - interior.points).max() <= boundary_error + 1e-9
+    assert interior.inverted == 0 and interior.min_jacobian > 3.9  # area x4
+    assert np.allclose(interior.velocity(0.5), 2 * interior.displacement)
+
+
+def test_concentric_spheres_give_the_radial_field_inside():
+    s1 = trimesh.creation.icosphere(2)
+    field = mm.map_surfaces(s1, s1.copy().apply_scale(2.0), "diffusion")
+    boundary_error = np.abs(field.vectors - field.starts).max()
+    rng = np.random.default_rng(3)
+    inside = rng.normal(size=(300, 3))
+    inside *= (0.9 * rng.random(300) ** (1 / 3) / np.linalg.norm(inside, axis=1))[:, None]
+    points = np.vstack([s1.vertices, inside])
+    interior = mm.extend_field(field, mesh=(points, Delaunay(points).simplices))
+    assert np.abs(interior.displacement - interior.points).max() <= boundary_error + 1e-9
+    assert interior.inverted == 0
+
+
+def test_inversions_are_counted():
+    # A boundary map that turns part of the disc inside out (a half turn of one side).
+    c1 = circle(100)
+    ends = c1.copy()
+    right = c1[:, 0] > 0.5
+    ends[right, 0] = 1.0 - 2.5 * (c1[right, 0] - 0.5)
+    field = mm.DisplacementField(c1, ends, "normal", source=c1)
+    interior = mm.extend_field(field, mesh_size=0.1)
+    assert interior.inverted > 0 and interior.min_jacobian < 0
+
+
+def test_bad_input_is_named():
+    c1 = circle(40)
+    field = mm.DisplacementField(c1, 2 * c1, "normal", source=c1)
+    with pytest.raises(ValueError, match="method"):
+        mm.extend_field(field, method="elastic")
+    with pytest.raises(ValueError, match="mesh cells"):
+        mm.extend_field(field, mesh=(c1, np.zeros((3, 4), int)))
+    with pytest.raises(ValueError, match="mesh: cell 0 refers to point 99"):
+        mm.extend_field(field, mesh=(c1, np.array([[0, 1, 99]])))
+    flat = np.vstack([c1, [[0.0, 0.0], [0.5, 0.0], [1.0, 0.0]]])
+    cells = np.vstack([Delaunay(flat[:40]).simplices, [[40, 41, 42]]])
+    with pytest.raises(ValueError, match=r"mesh: cell \d+ is flat \(zero area\)"):
+        mm.extend_field(field, mesh=(flat, cells))
+    missed = mm.DisplacementField(c1, np.full_like(c1, np.nan), "normal", source=c1)
+    with pytest.raises(ValueError, match="field: has no displacement at"):
+        mm.extend_field(missed)
+    s1 = trimesh.creation.icosphere(1)
+    field3 = mm.map_surfaces(s1, s1.copy().apply_scale(1.5), "normal")
+    with pytest.raises(ValueError, match="mesh: 3D needs the solver's tetrahedral mesh"):
+        mm.extend_field(field3)
+    with pytest.raises(ValueError, match="boundary: this field does not know"):
+        mm.extend_field(mm.DisplacementField(c1, 2 * c1, "normal"))
