@@ -113,3 +113,31 @@ def test_map_reads_stacks_and_mesh_files(tmp_path):
     assert done.returncode == 2 and "--n applies to curves, not to surfaces" in done.stderr
     done = subprocess.run([*command, "--spacing", "2,0.5,0.5", "--method", "uniform"], capture_output=True, text=True)
     assert done.returncode == 2 and "method" in done.stderr
+
+
+def test_extend_writes_the_interior_displacement(tmp_path):
+    # The kidney pair: the field extended into the domain C1 encloses, on a mesh made here and on
+    # a solver's mesh read from a file; the interior is written where -o says.
+    import meshio
+    import numpy as np
+
+    c1, c2 = mm.load_example("kidney")
+    mm.write_curve(tmp_path / "c1.csv", c1)
+    mm.write_curve(tmp_path / "c2.csv", c2)
+    command = [sys.executable, "-m", "morphomap", "extend", str(tmp_path / "c1.csv"), str(tmp_path / "c2.csv")]
+    done = subprocess.run([*command, "--method", "diffusion", "--dt", "2", "-o", str(tmp_path / "u.vtu")],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert "InteriorField(" in done.stderr and "written to" in done.stderr
+    made = meshio.read(tmp_path / "u.vtu")
+    assert {"displacement", "velocity"} <= set(made.point_data)
+    solver = mm.extend_field(mm.map_curves(c1, c2, "diffusion"), mesh_size=0.1)
+    meshio.write(tmp_path / "solver.xdmf", meshio.Mesh(solver.points, [("triangle", solver.cells)]))
+    done = subprocess.run([*command, "--method", "diffusion", "--mesh", str(tmp_path / "solver.xdmf"),
+                           "-o", str(tmp_path / "u.txt")], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    table = np.loadtxt(tmp_path / "u.txt", comments="%")
+    assert np.allclose(table[:, :2], solver.points) and np.allclose(table[:, 2:], solver.displacement)
+    done = subprocess.run([*command, "--mesh", str(tmp_path / "u.txt"), "-o", str(tmp_path / "v.vtu")],
+                          capture_output=True, text=True)
+    assert done.returncode == 2 and "cannot read the mesh" in done.stderr

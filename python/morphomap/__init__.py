@@ -30,6 +30,7 @@ from .masks import boundary_from_mask, surface_from_mask
 from .mesh_files import read_surface, write_surface
 from .plot import plot_field, plot_field_3d
 from .quality import CurveQuality, SurfaceQuality, quality
+from .solver_files import write_interior
 from .queries import CurveHits, CurveIndex, closest_points, line_intersections
 from .surfaces import SurfaceHits, SurfaceIndex, map_surfaces, surface_normals
 from .transform import Similarity, align_curves, overlap_area
@@ -91,5 +92,6 @@ __all__ = [
     "surface_normals",
     "write_curve",
     "write_field",
+    "write_interior",
     "write_surface",
 ]

@@ -32,7 +32,8 @@ def _demo(args) -> int:
     return 0
 
 
-def _map(args, parser) -> int:
+def _read_and_map(args, parser):
+    """The two frames of `map` / `extend`, the field between them and its quality."""
     import morphomap
 
     frames = []
@@ -62,6 +63,21 @@ def _map(args, parser) -> int:
             q = morphomap.quality(field, c1, c2, closed=args.closed)
     except (ValueError, TypeError, morphomap.InvalidInput, morphomap.GeometryError) as error:
         parser.error(f"cannot map {args.c1} onto {args.c2} with --method {args.method}: {error}")
+    return c1, c2, from_image, field, q
+
+
+def _summary(field, q) -> str:
+    names, counts = np.unique(field.method, return_counts=True)
+    used = ", ".join(f"{name} {count}" for name, count in zip(names, counts))
+    defects = f"folds {q.folds}" if field.dim == 3 else f"crossings {q.crossings}"
+    return (f"{len(field)} vectors, {int(field.valid.sum())} valid, {int((~field.valid).sum())} missed ({used}); "
+            f"QM1 {q.qm1:.4g}  QM2 {q.qm2:.4g}  QM {q.qm:.4g}  {defects}")
+
+
+def _map(args, parser) -> int:
+    import morphomap
+
+    c1, c2, from_image, field, q = _read_and_map(args, parser)
     title = f"{args.method}: QM1 {q.qm1:.4g}  QM2 {q.qm2:.4g}  QM {q.qm:.4g}"
     try:
         morphomap.write_field(sys.stdout if args.output == "-" else args.output, field)
@@ -78,14 +94,38 @@ def _map(args, parser) -> int:
             save_figure(fig, args.plot, dpi=100)
     except OSError as error:
         parser.error(f"cannot write {error.filename}: {error.strerror or error}")
-    names, counts = np.unique(field.method, return_counts=True)
-    used = ", ".join(f"{name} {count}" for name, count in zip(names, counts))
-    defects = f"folds {q.folds}" if field.dim == 3 else f"crossings {q.crossings}"
-    summary = (f"{len(field)} vectors, {int(field.valid.sum())} valid, {int((~field.valid).sum())} missed ({used}); "
-               f"QM1 {q.qm1:.4g}  QM2 {q.qm2:.4g}  QM {q.qm:.4g}  {defects}")
     where = "" if args.output == "-" else f"; field written to {args.output}"
     where += f", plot to {args.plot}" if args.plot else ""
-    print(summary + where, file=sys.stderr)
+    print(_summary(field, q) + where, file=sys.stderr)
+    return 0
+
+
+def _extend(args, parser) -> int:
+    import morphomap
+
+    _, _, _, field, q = _read_and_map(args, parser)
+    mesh = None
+    if args.mesh:
+        import meshio
+
+        try:
+            solver_mesh = meshio.read(args.mesh)
+        except (OSError, ValueError, KeyError, meshio.ReadError) as error:
+            parser.error(f"cannot read the mesh {args.mesh}: {error}")
+        kind = "triangle" if field.dim == 2 else "tetra"
+        if kind not in solver_mesh.cells_dict:
+            parser.error(f"{args.mesh}: has no {kind} cells (found: {', '.join(solver_mesh.cells_dict) or 'none'})")
+        mesh = (solver_mesh.points[:, : field.dim], solver_mesh.cells_dict[kind])
+    try:
+        interior = morphomap.extend_field(field, mesh=mesh, mesh_size=args.extend_mesh_size)
+    except (ValueError, TypeError, morphomap.InvalidInput, morphomap.GeometryError) as error:
+        parser.error(f"cannot extend the field into {args.mesh or 'the domain'}: {error}")
+    try:
+        morphomap.write_interior(args.output, interior, dt=args.dt)
+    except OSError as error:
+        parser.error(f"cannot write {error.filename}: {error.strerror or error}")
+    print(f"{_summary(field, q)}; {interior!r}, boundary nodes within {interior.boundary_distance:.3g} of C1; "
+          f"written to {args.output}", file=sys.stderr)
     return 0
 
 
@@ -114,45 +154,60 @@ def main(argv=None) -> int:
     demo.add_argument("--out", default="morphomap-demo", metavar="DIR",
                       help="folder to write into (default: ./morphomap-demo)")
     demo.set_defaults(run=_demo)
-    mapping = commands.add_parser(
-        "map", help="map boundary C1 onto boundary C2 (curves, surfaces or masks) and write the displacement field",
-        description="Map boundary C1 (time t) onto boundary C2 (time t + dt): curves (CSV files of x,y rows, "
-                    "with an optional header) or 2D masks (PNG, TIFF, .npy), or closed surfaces (STL, PLY, OBJ, "
-                    "OFF) or 3D stacks (TIFF, .npy). Prints the vector count and quality measures to stderr.")
-    mapping.add_argument("c1", metavar="C1", help="the boundary at time t: a CSV curve, a mesh file, a 2D mask or a 3D stack")
-    mapping.add_argument("c2", metavar="C2", help="the boundary at time t + dt, likewise")
-    mapping.add_argument("--spacing", type=_spacing, default=None, metavar="S[,S[,S]]",
-                         help="pixel or voxel size of masks: one value, or one per axis (rows,columns; sz,sy,sx) "
-                              "(default: what the file states, else 1)")
-    mapping.add_argument("--label", type=int, default=None, help="the object's value in a label image")
-    mapping.add_argument("--smooth", type=_length, default=0.0, metavar="W",
-                         help="Gaussian width (physical units) applied to masks before contouring (default 0)")
-    mapping.add_argument("--edge-length", type=lambda text: _length(text, positive=True), default=None, metavar="L",
-                         help="triangle edge length of surfaces from 3D stacks (default: the largest voxel size)")
-    mapping.add_argument("--method", default="auto", choices=CURVE_METHODS, help="the algorithm (default: auto)")
-    closed = mapping.add_mutually_exclusive_group()
+    common = argparse.ArgumentParser(add_help=False)
+    common.add_argument("c1", metavar="C1", help="the boundary at time t: a CSV curve, a mesh file, a 2D mask or a 3D stack")
+    common.add_argument("c2", metavar="C2", help="the boundary at time t + dt, likewise")
+    common.add_argument("--spacing", type=_spacing, default=None, metavar="S[,S[,S]]",
+                        help="pixel or voxel size of masks: one value, or one per axis (rows,columns; sz,sy,sx) "
+                             "(default: what the file states, else 1)")
+    common.add_argument("--label", type=int, default=None, help="the object's value in a label image")
+    common.add_argument("--smooth", type=_length, default=0.0, metavar="W",
+                        help="Gaussian width (physical units) applied to masks before contouring (default 0)")
+    common.add_argument("--edge-length", type=lambda text: _length(text, positive=True), default=None, metavar="L",
+                        help="triangle edge length of surfaces from 3D stacks (default: the largest voxel size)")
+    common.add_argument("--method", default="auto", choices=CURVE_METHODS, help="the algorithm (default: auto)")
+    closed = common.add_mutually_exclusive_group()
     closed.add_argument("--closed", dest="closed", action="store_true", default=True,
                         help="the curves are closed (the default)")
     closed.add_argument("--open", dest="closed", action="store_false", help="the curves are open")
-    mapping.add_argument("--n", type=_positive, default=None, metavar="N",
-                         help="resample both curves to N equally spaced points first")
-    mapping.add_argument("--reverse", action="store_true", help="map C2 onto C1 and flip the vectors")
-    mapping.add_argument("--transform", action="store_true",
-                         help="move C1 close to C2 first (the paper's Appendix A), then map")
-    mapping.add_argument("--no-split", dest="split", action="store_false",
-                         help="do not split the curves where they cross")
-    mapping.add_argument("--contact-tolerance", type=_length, default=None, metavar="D",
-                         help="curves closer than D are in contact there: split and mapped to the closest point "
-                              "(default: 1%% of the finer median point spacing)")
-    mapping.add_argument("--mesh-size", type=lambda text: _length(text, positive=True), default=None, metavar="H",
-                         help="the diffusion mesh size (default: from the gap between the curves)")
+    common.add_argument("--n", type=_positive, default=None, metavar="N",
+                        help="resample both curves to N equally spaced points first")
+    common.add_argument("--reverse", action="store_true", help="map C2 onto C1 and flip the vectors")
+    common.add_argument("--transform", action="store_true",
+                        help="move C1 close to C2 first (the paper's Appendix A), then map")
+    common.add_argument("--no-split", dest="split", action="store_false",
+                        help="do not split the curves where they cross")
+    common.add_argument("--contact-tolerance", type=_length, default=None, metavar="D",
+                        help="curves closer than D are in contact there: split and mapped to the closest point "
+                             "(default: 1%% of the finer median point spacing)")
+    common.add_argument("--mesh-size", type=lambda text: _length(text, positive=True), default=None, metavar="H",
+                        help="the diffusion mesh size (default: from the gap between the curves)")
+    mapping = commands.add_parser(
+        "map", parents=[common], help="map boundary C1 onto boundary C2 (curves, surfaces or masks) and write the displacement field",
+        description="Map boundary C1 (time t) onto boundary C2 (time t + dt): curves (CSV files of x,y rows, "
+                    "with an optional header) or 2D masks (PNG, TIFF, .npy), or closed surfaces (STL, PLY, OBJ, "
+                    "OFF) or 3D stacks (TIFF, .npy). Prints the vector count and quality measures to stderr.")
     mapping.add_argument("-o", "--output", default="-", metavar="FIELD.csv",
-                         help="where to write the field (columns start_x,start_y,end_x,end_y,valid,method; 3D: "
-                              "with start_z, end_z and the faces); "
-                              "default: standard output")
+                         help="where to write the field: .csv (columns start_x,start_y,end_x,end_y,valid,method; 3D: "
+                              "with start_z, end_z and the faces), .vtu, .xdmf or a COMSOL .txt table; "
+                              "default: CSV to standard output")
     mapping.add_argument("--plot", metavar="FIELD.png",
                          help="also draw the field into this image file (2D masks: y down, as the image looks)")
     mapping.set_defaults(run=lambda args: _map(args, mapping))
+    extend = commands.add_parser(
+        "extend", parents=[common],
+        help="map C1 onto C2 and extend the field into the domain C1 encloses (the solver's mesh motion)",
+        description="Map boundary C1 onto C2 as `map` does, then extend the displacement harmonically into the "
+                    "domain C1 encloses: on the solver's own mesh (--mesh, triangles in 2D, tetrahedra in 3D, any "
+                    "file meshio reads) or, in 2D, on a mesh made by CGAL. Writes the interior displacement.")
+    extend.add_argument("--mesh", metavar="MESH", help="the solver's mesh of the domain (.xdmf, .vtu, .msh, ...)")
+    extend.add_argument("--extend-mesh-size", type=lambda text: _length(text, positive=True), default=None,
+                        metavar="H", help="2D without --mesh: the largest edge of the mesh made (default: graded)")
+    extend.add_argument("--dt", type=lambda text: _length(text, positive=True), default=None, metavar="DT",
+                        help="the time between the frames: also write the velocity")
+    extend.add_argument("-o", "--output", required=True, metavar="U.xdmf",
+                        help="where to write the interior displacement (.xdmf, .vtu or a COMSOL .txt)")
+    extend.set_defaults(run=lambda args: _extend(args, extend))
     args = parser.parse_args(argv)
     try:
         return args.run(args)

@@ -1,0 +1,174 @@
+"""Fields and interior displacements in solver files, opened by the real clients.
+
+FEniCSx (Debian's python3-dolfinx, the system Python) and ParaView (pvpython, Debian's
+python3-paraview) run as subprocesses; .ci/run installs both, so that in CI these never skip.
+"""
+
+import json
+import os
+import shutil
+import subprocess
+import textwrap
+
+import meshio
+import numpy as np
+import pytest
+import trimesh
+
+import morphomap as mm
+from conftest import circle, require_client
+
+A2, B2 = np.array([[1.2, 0.3], [-0.1, 0.9]]), np.array([0.3, -0.2])
+SYSTEM_PYTHON = "/usr/bin/python3"
+
+
+def affine_interior():
+    c1 = circle(80)
+    field = mm.DisplacementField(c1, c1 @ A2.T + B2, "normal", source=c1)
+    return field, mm.extend_field(field, mesh_size=0.15)
+
+
+def run_client(command, script, tmp_path):
+    (tmp_path / "client.py").write_text(textwrap.dedent(script))
+    done = subprocess.run([*command, str(tmp_path / "client.py")], capture_output=True, text=True, timeout=300,
+                          cwd=tmp_path)
+    assert done.returncode == 0, done.stderr[-3000:]
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def dolfinx_available():
+    if not os.path.exists(SYSTEM_PYTHON):
+        return False
+    return subprocess.run([SYSTEM_PYTHON, "-c", "import dolfinx, h5py"], capture_output=True).returncode == 0
+
+
+def test_meshio_round_trips_every_format(tmp_path):
+    field, interior = affine_interior()
+    for suffix in (".vtu", ".xdmf"):
+        mm.write_interior(tmp_path / f"u{suffix}", interior, dt=0.5)
+        back = meshio.read(tmp_path / f"u{suffix}")
+        assert np.allclose(back.points[:, :2], interior.points)
+        assert np.array_equal(back.cells_dict["triangle"], interior.cells)
+        assert np.allclose(back.point_data["displacement"][:, :2], interior.displacement)
+        assert np.allclose(back.point_data["velocity"][:, :2], interior.displacement / 0.5)
+        mm.write_field(tmp_path / f"f{suffix}", field)
+        back = meshio.read(tmp_path / f"f{suffix}")
+        assert np.allclose(back.points[:, :2], field.starts)
+        assert np.allclose(back.point_data["displacement"][:, :2], field.vectors)
+        assert back.point_data["valid"].tolist() == [1] * len(field)
+    # 3D fields carry their triangles.
+    s1 = trimesh.creation.icosphere(2)
+    field3 = mm.map_surfaces(s1, s1.copy().apply_scale(1.5), "normal")
+    mm.write_field(tmp_path / "f3.vtu", field3)
+    back = meshio.read(tmp_path / "f3.vtu")
+    assert np.array_equal(back.cells_dict["triangle"], field3.faces)
+    assert np.allclose(back.point_data["displacement"], field3.vectors)
+    # .xdmf leaves its .h5 beside it and nothing else.
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        ["u.vtu", "u.xdmf", "u.h5", "f.vtu", "f.xdmf", "f.h5", "f3.vtu"])
+
+
+def test_comsol_table(tmp_path):
+    field, interior = affine_interior()
+    mm.write_interior(tmp_path / "u.txt", interior)
+    lines = (tmp_path / "u.txt").read_text().splitlines()
+    assert lines[0].startswith("% morphomap interior displacement") and lines[1] == "% x y ux uy"
+    table = np.loadtxt(tmp_path / "u.txt", comments="%")
+    assert np.array_equal(table[:, :2], interior.points) and np.array_equal(table[:, 2:], interior.displacement)
+    ends = field.ends.copy()
+    ends[3] = np.nan
+    mm.write_field(tmp_path / "f.txt", mm.DisplacementField(field.starts, ends, "normal"))
+    table = np.loadtxt(tmp_path / "f.txt", comments="%")
+    assert len(table) == len(field) - 1  # an interpolation table has no gaps
+
+
+def test_writes_are_atomic(tmp_path, monkeypatch):
+    _, interior = affine_interior()
+    mm.write_interior(tmp_path / "u.xdmf", interior)
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+
+    def broken(*args, **kwargs):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(meshio, "write", broken)
+    with pytest.raises(OSError, match="disk full"):
+        mm.write_interior(tmp_path / "u.xdmf", interior)
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+    with pytest.raises(ValueError, match="unknown format '.stl'"):
+        mm.write_interior(tmp_path / "u.stl", interior)
+
+
+def test_fenicsx_reads_the_mesh_and_the_displacement(tmp_path):
+    # FEniCSx reads the mesh, the displacement goes into a P1 vector function by the nodes' input
+    # indices, and dolfinx integrates div u over the domain: (trace A - 2) times the area for an
+    # affine map; the nodal values are the affine map's at dolfinx's own coordinates.
+    require_client(dolfinx_available(), "FEniCSx (python3-dolfinx, python3-h5py)")
+    _, interior = affine_interior()
+    mm.write_interior(tmp_path / "u.xdmf", interior)
+    got = run_client([SYSTEM_PYTHON], """
+        import json
+        import h5py
+        import numpy as np
+        import ufl
+        from dolfinx import fem, io
+        from mpi4py import MPI
+
+        with io.XDMFFile(MPI.COMM_WORLD, "u.xdmf", "r") as xdmf:
+            mesh = xdmf.read_mesh(name="Grid")
+        import xml.etree.ElementTree as ElementTree
+
+        # The displacement's dataset, as the XDMF file names it.
+        item = ElementTree.parse("u.xdmf").find(".//Attribute[@Name='displacement']/DataItem").text
+        file, dataset = item.strip().split(":")
+        with h5py.File(file, "r") as h5:
+            displacement = h5[dataset][...]
+        V = fem.VectorFunctionSpace(mesh, ("CG", 1))
+        u = fem.Function(V)
+        # P1 on a P1 geometry: dof i sits at geometry node i, whose input index says which row it is.
+        original = mesh.geometry.input_global_indices
+        u.x.array[:] = displacement[original].ravel()
+        area = fem.assemble_scalar(fem.form(fem.Constant(mesh, 1.0) * ufl.dx))
+        divergence = fem.assemble_scalar(fem.form(ufl.div(u) * ufl.dx))
+        print(json.dumps({"nodes": mesh.geometry.x.shape[0], "area": area, "divergence": divergence,
+                          "x": mesh.geometry.x[:, :2].tolist(), "u": u.x.array.reshape(-1, 2).tolist()}))
+    """, tmp_path)
+    assert got["nodes"] == len(interior.points)
+    x, u = np.array(got["x"]), np.array(got["u"])
+    assert np.abs(u - (x @ A2.T + B2 - x)).max() < 1e-10
+    assert got["divergence"] == pytest.approx((np.trace(A2) - 2) * got["area"], rel=1e-10)
+
+
+def test_paraview_reads_the_arrays(tmp_path):
+    require_client(shutil.which("pvpython") is not None, "ParaView (pvpython, python3-paraview)")
+    field, interior = affine_interior()
+    mm.write_interior(tmp_path / "u.vtu", interior, dt=2.0)
+    mm.write_interior(tmp_path / "u.xdmf", interior)
+    mm.write_field(tmp_path / "f.vtu", field)
+    got = run_client(["pvpython"], """
+        import json
+        from paraview import servermanager
+        from paraview.simple import OpenDataFile, XDMFReader
+        from vtk.util.numpy_support import vtk_to_numpy
+
+        out = {}
+        for name in ("u.vtu", "u.xdmf", "f.vtu"):
+            # VTK files with the reader File > Open picks; XDMF with the "XDMF Reader": Debian 12's
+            # ParaView 5.11 Xdmf3 readers abort on HDF5-backed XDMF (dolfinx's own files too).
+            source = XDMFReader(FileNames=[name]) if name.endswith(".xdmf") else OpenDataFile(name)
+            source.UpdatePipeline()
+            data = servermanager.Fetch(source)
+            if data.IsA("vtkMultiBlockDataSet"):
+                data = data.GetBlock(0)
+            arrays = data.GetPointData()
+            out[name] = {"points": vtk_to_numpy(data.GetPoints().GetData()).tolist(), "cells": data.GetNumberOfCells(),
+                         **{arrays.GetArrayName(k): vtk_to_numpy(arrays.GetArray(k)).tolist()
+                            for k in range(arrays.GetNumberOfArrays())}}
+        print(json.dumps(out))
+    """, tmp_path)
+    for name in ("u.vtu", "u.xdmf"):
+        assert got[name]["cells"] == len(interior.cells)
+        assert np.allclose(np.array(got[name]["points"])[:, :2], interior.points)
+        assert np.allclose(np.array(got[name]["displacement"])[:, :2], interior.displacement)
+    assert np.allclose(np.array(got["u.vtu"]["velocity"])[:, :2], interior.displacement / 2.0)
+    assert np.allclose(np.array(got["f.vtu"]["displacement"])[:, :2], field.vectors)
+    assert got["f.vtu"]["valid"] == [1] * len(field)
