@@ -141,3 +141,26 @@ def test_extend_writes_the_interior_displacement(tmp_path):
     done = subprocess.run([*command, "--mesh", str(tmp_path / "u.txt"), "-o", str(tmp_path / "v.vtu")],
                           capture_output=True, text=True)
     assert done.returncode == 2 and "cannot read the mesh" in done.stderr
+
+
+def test_series_and_batch_commands(tmp_path):
+    import numpy as np
+
+    from conftest import circle
+
+    paths = []
+    for k in range(3):
+        paths.append(tmp_path / f"t{k}.csv")
+        mm.write_curve(paths[-1], circle(120, 1.0 + 0.3 * k))
+    done = subprocess.run([sys.executable, "-m", "morphomap", "series", *map(str, paths), "--method", "normal",
+                           "--out", str(tmp_path / "series")], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert "step 1:" in done.stderr and "3 frames in 2D" in done.stderr
+    table = np.loadtxt(tmp_path / "series" / "trajectories.csv", delimiter=",", skiprows=1)
+    assert np.allclose(np.linalg.norm(table[table[:, 0] == 2][:, 2:], axis=1), 1.6)
+    (tmp_path / "jobs.csv").write_text("c1,c2\nt0.csv,t1.csv\nt1.csv,t2.csv,diffusion\nt0.csv,missing.csv\n")
+    command = [sys.executable, "-m", "morphomap", "batch", str(tmp_path / "jobs.csv"), "--out", str(tmp_path / "b"),
+               "--workers", "2"]
+    done = subprocess.run(command, capture_output=True, text=True)
+    assert done.returncode == 1 and "3 jobs: 2 done or skipped, 1 failed" in done.stderr, done.stderr
+    assert mm.read_field(tmp_path / "b" / "002_t1_t2.csv").method[0] == "diffusion"

@@ -30,6 +30,8 @@ from .masks import boundary_from_mask, surface_from_mask
 from .mesh_files import read_surface, write_surface
 from .plot import plot_field, plot_field_3d
 from .quality import CurveQuality, SurfaceQuality, quality
+from .batch import Job, map_batch
+from .series import Series, map_series
 from .solver_files import write_interior
 from .queries import CurveHits, CurveIndex, closest_points, line_intersections
 from .surfaces import SurfaceHits, SurfaceIndex, map_surfaces, surface_normals
@@ -53,6 +55,8 @@ __all__ = [
     "Image",
     "InteriorField",
     "InvalidInput",
+    "Job",
+    "Series",
     "ShellDiffusionSolution",
     "Similarity",
     "SurfaceHits",
@@ -70,7 +74,9 @@ __all__ = [
     "is_self_intersecting",
     "line_intersections",
     "load_example",
+    "map_batch",
     "map_curves",
+    "map_series",
     "map_surfaces",
     "normals",
     "orientation",

@@ -139,6 +139,70 @@ _CURVE_ONLY = {
 }
 
 
+def _series(args, parser) -> int:
+    import morphomap
+
+    frames = []
+    for path in args.frames:
+        try:
+            frames.append(_read_frame(path, args)[0])
+        except OSError as error:
+            parser.error(f"cannot read {path}: {error.strerror or error}")
+        except (ValueError, TypeError) as error:
+            parser.error(f"{path}: {error}")
+    try:
+        series = morphomap.map_series(frames, args.method)
+    except (ValueError, TypeError, morphomap.InvalidInput, morphomap.GeometryError) as error:
+        parser.error(str(error))
+    try:
+        written = series.write(args.out)
+    except OSError as error:
+        parser.error(f"cannot write {error.filename}: {error.strerror or error}")
+    for q in series.quality:
+        kind = "crossings" if series.dim == 2 else "folds"
+        print(f"step {q.step}: QM1 {q.qm1:.4g}  QM2 {q.qm2:.4g}  QM {q.qm:.4g}  {kind} {q.defects}  misses {q.misses}  "
+              f"{q.seconds:.2f} s", file=sys.stderr)
+    print(f"{series!r}; {len(written)} files written to {args.out}", file=sys.stderr)
+    return 0
+
+
+def _batch(args, parser) -> int:
+    import csv
+    import os
+
+    from .batch import Job, map_batch
+
+    try:
+        with open(args.manifest, newline="", encoding="utf-8") as handle:
+            rows = [row for row in csv.reader(handle) if row and not row[0].startswith("#")]
+    except OSError as error:
+        parser.error(f"cannot read {args.manifest}: {error.strerror or error}")
+    if rows and rows[0][:2] == ["c1", "c2"]:
+        rows = rows[1:]
+    base = os.path.dirname(os.path.abspath(args.manifest))
+    os.makedirs(args.out, exist_ok=True)
+    jobs = []
+    for number, row in enumerate(rows, start=1):
+        if len(row) not in (2, 3):
+            parser.error(f"{args.manifest}: row {number}: expected c1,c2[,method], got {len(row)} values")
+        c1, c2 = (p if os.path.isabs(p) else os.path.join(base, p) for p in row[:2])
+        stem = f"{number:03d}_{os.path.splitext(os.path.basename(c1))[0]}_{os.path.splitext(os.path.basename(c2))[0]}"
+        jobs.append(Job(c1, c2, os.path.join(args.out, stem + ".csv"), row[2] if len(row) == 3 else args.method,
+                        args.spacing, args.smooth))
+    client = None
+    if args.scheduler:
+        from distributed import Client
+
+        client = Client(args.scheduler)
+    results = map_batch(jobs, client=client, workers=args.workers)
+    for r in results:
+        print(f"{r.status:8s} {r.job.c1} -> {r.job.c2}: {r.message}", file=sys.stderr)
+    failed = sum(r.status == "failed" for r in results)
+    print(f"{len(results)} jobs: {len(results) - failed} done or skipped, {failed} failed; fields in {args.out}",
+          file=sys.stderr)
+    return 1 if failed else 0
+
+
 def main(argv=None) -> int:
     from .mapping import CURVE_METHODS
 
@@ -208,6 +272,31 @@ def main(argv=None) -> int:
     extend.add_argument("-o", "--output", required=True, metavar="U.xdmf",
                         help="where to write the interior displacement (.xdmf, .vtu or a COMSOL .txt)")
     extend.set_defaults(run=lambda args: _extend(args, extend))
+    series = commands.add_parser(
+        "series", help="map every consecutive pair of a time series and follow the first frame's points",
+        description="Map frame k onto frame k + 1 for every k (curves, surfaces, masks or stacks, all of one kind) "
+                    "and carry the points of the first frame through the fields; write the fields, the "
+                    "trajectories and the quality per step into --out.")
+    series.add_argument("frames", nargs="+", metavar="FRAME")
+    for option in ("--spacing", "--label", "--smooth", "--edge-length", "--method"):
+        action = next(a for a in common._actions if option in a.option_strings)
+        series._add_action(action)
+    series.add_argument("--out", required=True, metavar="DIR", help="the folder to write into")
+    series.set_defaults(run=lambda args: _series(args, series))
+    batch = commands.add_parser(
+        "batch", help="map many pairs on Dask distributed (a local cluster, or --scheduler)",
+        description="Map every pair listed in MANIFEST.csv (rows c1,c2[,method], paths relative to the manifest) as "
+                    "a Dask task; a failing task or a dying worker is reported and the others finish; fields are "
+                    "written atomically into --out, and a rerun skips the pairs already done.")
+    batch.add_argument("manifest", metavar="MANIFEST.csv")
+    batch.add_argument("--out", required=True, metavar="DIR")
+    batch.add_argument("--scheduler", metavar="ADDRESS", help="a running Dask scheduler (default: a local cluster)")
+    batch.add_argument("--workers", type=_positive, default=None, metavar="N",
+                       help="worker processes of the local cluster (default: one per core)")
+    for option in ("--spacing", "--smooth", "--method"):
+        action = next(a for a in common._actions if option in a.option_strings)
+        batch._add_action(action)
+    batch.set_defaults(run=lambda args: _batch(args, batch))
     args = parser.parse_args(argv)
     try:
         return args.run(args)
@@ -216,40 +305,13 @@ def main(argv=None) -> int:
         return 130
 
 
-IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".npy")
-
-
-def _is_image(path: str) -> bool:
-    return path.lower().endswith(IMAGE_SUFFIXES)
-
-
 def _read_frame(path: str, args):
-    """``(frame, from_image)``: the curve (CSV) or surface (mesh file) in ``path``, or the boundary of
-    the mask in an image file (2D: a curve, 3D stack: a surface) at --spacing, else the file's,
-    else 1 (said on stderr)."""
-    from .images import read_image
-    from .io import read_curve
-    from .masks import boundary_from_mask, surface_from_mask
-    from .mesh_files import SURFACE_SUFFIXES, read_surface
+    """``(frame, from_image)`` for the command line: read_boundary with its options, the spacing
+    used said on stderr."""
+    from .frames import read_boundary
 
-    if path.lower().endswith(SURFACE_SUFFIXES):
-        return read_surface(path), False
-    if not _is_image(path):
-        return read_curve(path), False
-    data, stated = read_image(path)
-    if data.ndim not in (2, 3):
-        raise ValueError(f"a {data.ndim}D image (shape {data.shape}): expected a 2D mask or a 3D stack")
-    if args.spacing is not None:
-        spacing, source = tuple(args.spacing), "--spacing"
-    elif stated is not None:
-        spacing, source = tuple(float(v) for v in stated), "the file"
-    else:
-        spacing, source = (1.0,), "no spacing in the file, none given"
-    unit = "pixel" if data.ndim == 2 else "voxel"
-    print(f"{path}: {unit} spacing {' x '.join(f'{v:g}' for v in spacing)} ({source})", file=sys.stderr)
-    if data.ndim == 2:
-        return boundary_from_mask(data, spacing, label=args.label, smooth=args.smooth), True
-    return surface_from_mask(data, spacing, label=args.label, smooth=args.smooth, edge_length=args.edge_length), True
+    return read_boundary(path, spacing=args.spacing, label=args.label, smooth=args.smooth,
+                         edge_length=args.edge_length, report=lambda text: print(text, file=sys.stderr))
 
 
 def _spacing(text: str) -> tuple:

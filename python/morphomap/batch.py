@@ -1,0 +1,105 @@
+"""Batches of mappings on Dask distributed: a local cluster of worker processes, or yours.
+
+Each job maps one pair of frame files and writes its field; a job that fails, or whose worker
+process dies (a crash in a native library, say), is reported with its error while the others
+finish. Outputs are written atomically, so a rerun skips the jobs whose output exists.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from dataclasses import dataclass
+
+
+@dataclass
+class Job:
+    """One pair: frame files ``c1`` and ``c2`` (curves, surfaces, masks or stacks), the field
+    written to ``output`` (any suffix :func:`morphomap.write_field` takes), and the options."""
+
+    c1: str
+    c2: str
+    output: str
+    method: str = "auto"
+    spacing: tuple | None = None
+    smooth: float = 0.0
+
+
+@dataclass
+class JobResult:
+    job: Job
+    status: str  # "done", "skipped" (its output existed) or "failed"
+    message: str = ""  # the summary, or the error
+
+
+def run_job(job: Job) -> str:
+    """Map one job in this process; returns a one-line summary. Raises on failure."""
+    import numpy as np
+
+    import morphomap as mm
+
+    from .frames import read_boundary
+
+    (b1, _), (b2, _) = (read_boundary(p, spacing=job.spacing, smooth=job.smooth) for p in (job.c1, job.c2))
+    if isinstance(b1, np.ndarray):
+        field = mm.map_curves(b1, b2, job.method)
+    else:
+        field = mm.map_surfaces(b1, b2, job.method)
+    q = mm.quality(field, b1, b2)
+    mm.write_field(job.output, field)
+    defects = f"crossings {q.crossings}" if field.dim == 2 else f"folds {q.folds}"
+    return f"{len(field)} vectors, {int((~field.valid).sum())} missed, QM {q.qm:.4g}, {defects}"
+
+
+def map_batch(jobs, client=None, *, workers=None, progress=None, task=None) -> list:
+    """Run ``jobs`` (a list of :class:`Job`) as Dask tasks; returns one :class:`JobResult` each.
+
+    ``task``: the function each job runs in its worker (default :func:`run_job`; it gets the job
+    and returns a summary line, writing ``job.output`` atomically).
+    ``client``: a ``distributed.Client`` (e.g. ``Client("tcp://scheduler:8786")`` for a cluster);
+    by default a local cluster of ``workers`` processes (one thread each) is started and closed.
+    A task is not retried on another worker when its worker dies: the job is reported failed.
+    """
+    import dask
+    from distributed import Client, LocalCluster, as_completed
+
+    jobs = list(jobs)
+    results = {}
+    pending = []
+    for k, job in enumerate(jobs):
+        if not isinstance(job, Job):
+            raise TypeError(f"jobs[{k}]: expected a morphomap.batch.Job, got {type(job).__name__}")
+        if os.path.exists(job.output):
+            results[k] = JobResult(job, "skipped", "output exists")
+        else:
+            pending.append(k)
+    if not pending:
+        return [results[k] for k in range(len(jobs))]
+    own = client is None
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+        if own:
+            cluster = LocalCluster(n_workers=workers or min(len(pending), os.cpu_count() or 1), threads_per_worker=1,
+                                   processes=True, dashboard_address=None)
+            client = Client(cluster)
+        try:
+            work = run_job if task is None else task
+            futures = {client.submit(work, jobs[k], pure=False, key=f"morphomap-job-{k}"): k for k in pending}
+            done = as_completed(futures)
+            if progress is not False and (progress or sys.stderr.isatty()):
+                try:
+                    from tqdm import tqdm
+
+                    done = tqdm(done, total=len(futures), desc="map_batch", unit="job")
+                except ImportError:
+                    pass
+            for future in done:
+                k = futures[future]
+                try:
+                    results[k] = JobResult(jobs[k], "done", future.result())
+                except Exception as error:  # the job's own error, or KilledWorker when its process died
+                    results[k] = JobResult(jobs[k], "failed", f"{type(error).__name__}: {error}")
+        finally:
+            if own:
+                client.close()
+                cluster.close()
+    return [results[k] for k in range(len(jobs))]
