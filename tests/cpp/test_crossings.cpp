@@ -3,7 +3,9 @@
 #include <morphomap/errors.hpp>
 
 #include "check.hpp"
+#include "crossing_sweep.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -31,6 +33,8 @@ std::vector<Pair> pairs_of(const std::vector<Segment>& segments) {
   }
   const std::vector<Pair> pairs = crossing_pairs(a, b);
   CHECK(count_crossings(a, b) == static_cast<Index>(pairs.size()));
+  // Small inputs are answered by the box search; the sweep must agree.
+  CHECK(morphomap::detail::crossing_pairs_by_sweep(a, b) == pairs);
   return pairs;
 }
 
@@ -112,6 +116,123 @@ void test_fields() {
   }
 }
 
+// The exact O(n²) definition, for comparison with the sweep.
+using Pt = std::pair<double, double>;
+int orient_sign(Pt a, Pt b, Pt c) {
+  // Small integers (and multiples of 1/4): exact in double.
+  const double d = (b.first - a.first) * (c.second - a.second) - (b.second - a.second) * (c.first - a.first);
+  return (d > 0) - (d < 0);
+}
+bool on_box(Pt a, Pt b, Pt c) {
+  return std::min(a.first, b.first) <= c.first && c.first <= std::max(a.first, b.first) &&
+         std::min(a.second, b.second) <= c.second && c.second <= std::max(a.second, b.second);
+}
+bool brute_cross(const Segment& s, const Segment& t) {
+  const Pt a = s.first, b = s.second, c = t.first, d = t.second;
+  const int o1 = orient_sign(a, b, c), o2 = orient_sign(a, b, d), o3 = orient_sign(c, d, a), o4 = orient_sign(c, d, b);
+  const bool meet = (o1 * o2 < 0 && o3 * o4 < 0) || (o1 == 0 && on_box(a, b, c)) || (o2 == 0 && on_box(a, b, d)) ||
+                    (o3 == 0 && on_box(c, d, a)) || (o4 == 0 && on_box(c, d, b));
+  if (!meet) return false;
+  for (const auto& [x, u] : {std::pair<Pt, Pt>{a, b}, std::pair<Pt, Pt>{b, a}}) {
+    for (const auto& [y, w] : {std::pair<Pt, Pt>{c, d}, std::pair<Pt, Pt>{d, c}}) {
+      if (x == y) {
+        const double dot = (u.first - x.first) * (w.first - x.first) + (u.second - x.second) * (w.second - x.second);
+        return orient_sign(x, u, w) == 0 && dot > 0;
+      }
+    }
+  }
+  return true;
+}
+bool finite(const Segment& s) {
+  return std::isfinite(s.first.first) && std::isfinite(s.first.second) && std::isfinite(s.second.first) &&
+         std::isfinite(s.second.second);
+}
+std::vector<Pair> brute_pairs(const std::vector<Segment>& segments) {
+  std::vector<Pair> pairs;
+  for (std::size_t i = 0; i < segments.size(); ++i) {
+    for (std::size_t j = i + 1; j < segments.size(); ++j) {
+      if (finite(segments[i]) && finite(segments[j]) && brute_cross(segments[i], segments[j])) {
+        pairs.emplace_back(static_cast<Index>(i), static_cast<Index>(j));
+      }
+    }
+  }
+  return pairs;
+}
+
+void test_against_brute_force() {
+  // CGAL 5.5's surface sweep fails on these four.
+  const std::vector<Segment> four{{{0, 1}, {2, 3}}, {{3, 1}, {0, 3}}, {{3, 2}, {1, 2}}, {{1, 3}, {2, 1}}};
+  CHECK(pairs_of(four) == brute_pairs(four));
+  CHECK(!pairs_of(four).empty());
+
+  // A fan of vectors into one point (and out of it), with repeated directions: no pair is a
+  // crossing except vectors that overlap.
+  std::mt19937 rng(11);
+  std::vector<Segment> fan, out;
+  for (int i = 0; i < 400; ++i) {
+    const Pt p{double(int(rng() % 9)) - 4, double(int(rng() % 9)) - 4};
+    fan.push_back({p, {0, 0}});
+    out.push_back({{0, 0}, p});
+  }
+  CHECK(pairs_of(fan) == brute_pairs(fan));
+  CHECK(pairs_of(out) == brute_pairs(out));
+
+  // Many through one point, plus segments through the centre's row and column.
+  std::vector<Segment> star;
+  for (int i = 0; i < 60; ++i) {
+    const double x = double(int(rng() % 7)), y = double(int(rng() % 7));
+    star.push_back({{x, y}, {6 - x, 6 - y}});
+    if (i % 5 == 0) star.push_back({{3, double(int(rng() % 7))}, {3, double(int(rng() % 7))}});
+    if (i % 7 == 0) star.push_back({{double(int(rng() % 7)), 3}, {double(int(rng() % 7)), 3}});
+    if (i % 11 == 0) star.push_back({{3, 3}, {3, 3}});
+  }
+  CHECK(pairs_of(star) == brute_pairs(star));
+
+  // Random small grids: shared starts, points, NaN rows, vertical and horizontal segments,
+  // collinear overlaps, and coordinates in quarters.
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (int round = 0; round < 1500; ++round) {
+    const int n = 2 + int(rng() % 50), size = 2 + int(rng() % 7), mode = int(rng() % 4);
+    const double scale = round % 3 == 0 ? 0.25 : 1.0;
+    auto g = [&] { return scale * double(int(rng() % size)); };
+    std::vector<Segment> segments;
+    for (int i = 0; i < n; ++i) {
+      Segment s{{g(), g()}, {g(), g()}};
+      if (mode == 1) (rng() % 2 ? s.second.first : s.second.second) = rng() % 2 ? s.first.first : s.first.second;
+      if (mode == 1 && rng() % 2) s.second.first = s.first.first;
+      if (mode == 1 && rng() % 2) s.second.second = s.first.second;
+      if (mode == 2) s.second = {scale * (size - 1) - s.first.first, scale * (size - 1) - s.first.second};
+      if (mode == 3 && rng() % 2) s.first.second = s.first.first, s.second.second = s.second.first;
+      if (i > 0 && rng() % 5 == 0) s.first = segments[rng() % i].first;
+      if (i > 0 && rng() % 8 == 0) s.second = segments[rng() % i].second;
+      if (rng() % 10 == 0) s.second = s.first;
+      if (rng() % 20 == 0) s.second.second = nan;
+      segments.push_back(s);
+    }
+    const std::vector<Pair> expected = brute_pairs(segments);
+    const std::vector<Pair> got = pairs_of(segments);
+    CHECK(got == expected);
+    if (got != expected) break;
+  }
+}
+
+void test_dense_parallel_field() {
+  // 20000 parallel slanted vectors: every pair of boxes overlaps (2e8 candidates), so the box
+  // search gives up and the sweep answers. Swapping the ends of vectors 2k and 2k + 1 for k < 10
+  // makes exactly those ten pairs cross.
+  const Index n = 20000;
+  Points2 a(n, 2), b(n, 2);
+  for (Index i = 0; i < n; ++i) {
+    a.row(i) << 1e-4 * i, 0.0;
+    b.row(i) << 1e-4 * i + 1.0, 1.0;
+  }
+  for (Index k = 0; k < 10; ++k) b.row(2 * k).swap(b.row(2 * k + 1));
+  CHECK(count_crossings(a, b) == 10);
+  const auto pairs = crossing_pairs(a, b);
+  CHECK(pairs.size() == 10u);
+  for (Index k = 0; k < Index(pairs.size()); ++k) CHECK(pairs[k] == Pair(2 * k, 2 * k + 1));
+}
+
 void test_validation() {
   const Points2 a = Points2::Zero(3, 2), b = Points2::Zero(2, 2);
   std::string message;
@@ -130,6 +251,8 @@ void test_validation() {
 int main() {
   test_pairs();
   test_fields();
+  test_against_brute_force();
+  test_dense_parallel_field();
   test_validation();
   TEST_MAIN_END();
 }
