@@ -86,6 +86,31 @@ void measure_inversions(Interior& out) {
   }
 }
 
+// The field's displacement at the mesh's boundary nodes (`fixed`; zero elsewhere until solved),
+// from project(boundary node positions), and the farthest of those nodes from the boundary.
+template <class Interior, class Project>
+void take_boundary_values(Interior& out, const std::vector<char>& fixed, const Project& project) {
+  using Rows = decltype(out.points);
+  std::vector<Index> nodes;
+  for (Index v = 0; v < out.points.rows(); ++v) {
+    if (fixed[v]) nodes.push_back(v);
+  }
+  Rows at(nodes.size(), out.points.cols());
+  for (std::size_t k = 0; k < nodes.size(); ++k) at.row(k) = out.points.row(nodes[k]);
+  const auto boundary = project(at);
+  out.displacement = Rows::Zero(out.points.rows(), out.points.cols());
+  Index missing = 0;
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    out.displacement.row(nodes[k]) = boundary.displacements.row(k);
+    missing += !boundary.displacements.row(k).allFinite();
+  }
+  if (missing > 0) {
+    detail::invalid("field", "has no displacement at " + std::to_string(missing) + " of the " +
+                                 std::to_string(nodes.size()) + " boundary nodes (the field has no target there)");
+  }
+  out.boundary_distance = boundary.distances.size() ? boundary.distances.maxCoeff() : 0.0;
+}
+
 template <class Interior, class Local>
 void solve_harmonic(Interior& out, const std::vector<char>& fixed, const Local& local, bool iterative) {
   // A flat cell has no gradients: its stiffness would be infinite.
@@ -118,24 +143,7 @@ InteriorField2 extend_field(const DisplacementField2& field, const Points2Ref& s
     out.cells = mesh_cells;
   }
   const std::vector<char> fixed = boundary_nodes(out.cells, out.points.rows());
-  std::vector<Index> nodes;
-  for (Index v = 0; v < out.points.rows(); ++v) {
-    if (fixed[v]) nodes.push_back(v);
-  }
-  Points2 at(nodes.size(), 2);
-  for (std::size_t k = 0; k < nodes.size(); ++k) at.row(k) = out.points.row(nodes[k]);
-  const DisplacementAt2 boundary = displacement_at(field, source, true, at);
-  out.displacement = Points2::Zero(out.points.rows(), 2);
-  Index missing = 0;
-  for (std::size_t k = 0; k < nodes.size(); ++k) {
-    out.displacement.row(nodes[k]) = boundary.displacements.row(k);
-    missing += !boundary.displacements.row(k).allFinite();
-  }
-  if (missing > 0) {
-    detail::invalid("field", "has no displacement at " + std::to_string(missing) + " of the " +
-                                 std::to_string(nodes.size()) + " boundary nodes (it has no valid vector)");
-  }
-  out.boundary_distance = boundary.distances.size() ? boundary.distances.maxCoeff() : 0.0;
+  take_boundary_values(out, fixed, [&](const Points2& at) { return displacement_at(field, source, true, at); });
   solve_harmonic(out, fixed, [&](Index t) {
     Vec2 p[3];
     for (int i = 0; i < 3; ++i) p[i] = out.points.row(out.cells(t, i)).transpose();
@@ -151,24 +159,7 @@ InteriorField3 extend_field(const DisplacementField3& field, const Points3Ref& m
   out.points = mesh_points;
   out.cells = mesh_cells;
   const std::vector<char> fixed = boundary_nodes(out.cells, out.points.rows());
-  std::vector<Index> nodes;
-  for (Index v = 0; v < out.points.rows(); ++v) {
-    if (fixed[v]) nodes.push_back(v);
-  }
-  Points3 at(nodes.size(), 3);
-  for (std::size_t k = 0; k < nodes.size(); ++k) at.row(k) = out.points.row(nodes[k]);
-  const DisplacementAt3 boundary = displacement_at(field, at);
-  out.displacement = Points3::Zero(out.points.rows(), 3);
-  Index missing = 0;
-  for (std::size_t k = 0; k < nodes.size(); ++k) {
-    out.displacement.row(nodes[k]) = boundary.displacements.row(k);
-    missing += !boundary.displacements.row(k).allFinite();
-  }
-  if (missing > 0) {
-    detail::invalid("field", "has no displacement at " + std::to_string(missing) + " of the " +
-                                 std::to_string(nodes.size()) + " boundary nodes (vectors without a target)");
-  }
-  out.boundary_distance = boundary.distances.size() ? boundary.distances.maxCoeff() : 0.0;
+  take_boundary_values(out, fixed, [&](const Points3& at) { return displacement_at(field, at); });
   solve_harmonic(out, fixed, [&](Index t) {
     Eigen::Matrix<double, 4, 3> g;
     const double volume = std::abs(detail::tetrahedron_gradients(out.points, out.cells, t, g));

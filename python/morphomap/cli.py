@@ -203,6 +203,12 @@ def _batch(args, parser) -> int:
     return 1 if failed else 0
 
 
+def _share(common, parser, options) -> None:
+    """Give ``parser`` the same ``options`` as ``common`` (one definition of each option's rules)."""
+    for option in options:
+        parser._add_action(next(a for a in common._actions if option in a.option_strings))
+
+
 def main(argv=None) -> int:
     from .mapping import CURVE_METHODS
 
@@ -278,9 +284,7 @@ def main(argv=None) -> int:
                     "and carry the points of the first frame through the fields; write the fields, the "
                     "trajectories and the quality per step into --out.")
     series.add_argument("frames", nargs="+", metavar="FRAME")
-    for option in ("--spacing", "--label", "--smooth", "--edge-length", "--method"):
-        action = next(a for a in common._actions if option in a.option_strings)
-        series._add_action(action)
+    _share(common, series, ("--spacing", "--label", "--smooth", "--edge-length", "--method"))
     series.add_argument("--out", required=True, metavar="DIR", help="the folder to write into")
     series.set_defaults(run=lambda args: _series(args, series))
     batch = commands.add_parser(
@@ -293,9 +297,7 @@ def main(argv=None) -> int:
     batch.add_argument("--scheduler", metavar="ADDRESS", help="a running Dask scheduler (default: a local cluster)")
     batch.add_argument("--workers", type=_positive, default=None, metavar="N",
                        help="worker processes of the local cluster (default: one per core)")
-    for option in ("--spacing", "--smooth", "--method"):
-        action = next(a for a in common._actions if option in a.option_strings)
-        batch._add_action(action)
+    _share(common, batch, ("--spacing", "--smooth", "--method"))
     batch.set_defaults(run=lambda args: _batch(args, batch))
     args = parser.parse_args(argv)
     try:
