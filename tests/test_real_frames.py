@@ -202,6 +202,34 @@ def test_surfaces_sharing_faces_still_map_with_auto():
     assert on_s2.max() < 1e-6 * np.ptp(s2.vertices, axis=0).max()
 
 
+@pytest.mark.parametrize("reverse", [False, True])
+def test_surfaces_sharing_faces_map_with_diffusion_and_the_shared_patch_stays(reverse):
+    """A bud grown on one side of a voxel ball: the far side's faces are shared exactly. Diffusion
+    cuts that patch out: its vertices map onto themselves, the rest follows streamlines."""
+    s1, s2 = voxel_surfaces()
+    field = mm.map_surfaces(s1, s2, "diffusion", reverse=reverse)
+    assert field.valid.all()
+    source = s2 if reverse else s1
+    target = s1 if reverse else s2
+    from_source = np.asarray(field.ends if reverse else field.starts)
+    to_target = np.asarray(field.starts if reverse else field.ends)
+    shared = mm.SurfaceIndex(target.vertices, target.faces).closest_points(source.vertices).distances == 0
+    assert shared.mean() > 0.3
+    assert np.array_equal(np.asarray(field.method) == ("reverse_minimal_distance" if reverse else "minimal_distance"),
+                          shared)
+    assert np.abs(to_target[shared] - from_source[shared]).max() < 1e-12
+    on_target = mm.SurfaceIndex(target.vertices, target.faces).closest_points(to_target).distances
+    assert on_target.max() < 1e-6 * np.ptp(target.vertices, axis=0).max()
+    assert mm.quality(field, s1, s2).folds == 0
+    # The bud's tip (S2's farthest point along +x, 36.5) is reached within a voxel; on reverse, it
+    # comes from S1's cap under the bud (S1: a ball of radius 11 about x = 21).
+    tip = s2.vertices[:, 0].max()
+    ends = np.asarray(field.ends)
+    assert tip - ends[:, 0].max() < 1.0
+    if reverse:
+        assert np.asarray(field.starts)[np.argmax(ends[:, 0]), 0] > 28.0
+
+
 def test_ctrl_c_stops_a_long_mapping_within_a_second(tmp_path):
     if os.name != "posix":
         pytest.skip("signals")
@@ -279,16 +307,22 @@ def test_diffusion_repairs_the_triangles_it_folds(seed, reverse):
 
 
 @pytest.mark.parametrize("seed", [5002, 5022])
-def test_surfaces_touching_over_a_patch_refuse_diffusion_at_once_and_auto_answers(seed):
+def test_surfaces_touching_over_a_patch_map_with_diffusion(seed):
     """Fuzz seeds whose frames are the same mask outside a growing cap (one unsmoothed, one
     smoothed): the surfaces share or nearly share faces there. Diffusion crashed inside Mesh_3
-    (5022) or spent minutes (a sibling pair took 218 s); now it refuses before meshing, and auto
-    falls back."""
+    (5022) or spent minutes (a sibling pair took 218 s), later refused them; now the patch is cut
+    out (its vertices map to their closest point) and the rest of the region is meshed."""
     import frames
 
     made = frames.pair(3, seed, None)
-    # The count of faces says the refusal came before meshing (Mesh_3's own refusal has none).
-    with pytest.raises(ValueError, match=r"s2: coincides with s1 over a patch \(\d+ faces of s1 lie within"):
-        mm.map_surfaces(made.s1, made.s2, method="diffusion")
-    field = mm.map_surfaces(made.s1, made.s2, method="auto")
-    assert np.all(field.valid)
+    (v1, f1), (v2, f2) = made.arrays(made.s1), made.arrays(made.s2)
+    for reverse in (False, True):
+        field = mm.map_surfaces(made.s1, made.s2, method="diffusion", reverse=reverse)
+        assert np.asarray(field.valid).mean() > 0.99
+        assert mm.quality(field, made.s1, made.s2).folds == 0
+        valid = np.asarray(field.valid)
+        on_s2 = mm.SurfaceIndex(v2, f2).closest_points(np.asarray(field.ends)[valid]).distances
+        on_s1 = mm.SurfaceIndex(v1, f1).closest_points(np.asarray(field.starts)[valid]).distances
+        assert max(on_s2.max(), on_s1.max()) < 1e-9 * np.ptp(v2, axis=0).max()
+        assert any("minimal_distance" in name for name in set(np.asarray(field.method).tolist()))
+    assert np.all(mm.map_surfaces(made.s1, made.s2, method="auto").valid)

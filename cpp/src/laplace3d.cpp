@@ -5,6 +5,7 @@
 #include <morphomap/laplace3d.hpp>
 #include <morphomap/surface_queries.hpp>
 
+#include "contact3d.hpp"
 #include "dirichlet.hpp"
 #include "interrupt_check.hpp"
 #include "mesh_in_child.hpp"
@@ -38,6 +39,10 @@ constexpr double kFacetDistanceNested = 0.2;
 constexpr double kFacetDistanceCrossing = 0.05;
 // Surfaces closer than this fraction of their finer mean edge touch (as 2D's contact tolerance).
 constexpr double kTouchFraction = 0.01;
+// Where they come closer than this fraction of it, the source is pulled back to it (contact3d.hpp):
+// a thinner sliver would need elements of its own thickness.
+constexpr double kClearanceFraction = 0.5;
+constexpr int kClearanceAttempts = 5;
 using detail::free_vertex;
 using detail::source_vertex;
 using detail::target_vertex;
@@ -310,25 +315,37 @@ class Tracer {
   std::vector<double> step_;    // RK4 step length in each tetrahedron
 };
 
-// Where the surfaces touch over a patch (frames contoured on one voxel grid where the tissue did
-// not move, smoothed or not), the region between them is no volume there, and Mesh_3 either
-// refuses the exactly shared faces, spends minutes on the sliver between nearly shared ones (fuzz
-// seed 5038: 218 s) or crashes (seed 5022). A patch: a face of S1 with all three corners within
-// `tolerance` of S2.
-void require_no_touching_patch(const Points3Ref& source_vertices, const FacesRef& source_faces,
-                               const SurfaceIndex& target_index, double tolerance) {
-  const Vector distance = target_index.closest_points(source_vertices).distances;
-  Index touching = 0;
-  for (Index f = 0; f < source_faces.rows(); ++f) {
-    bool near = true;
-    for (int k = 0; k < 3; ++k) near = near && distance[source_faces(f, k)] <= tolerance;
-    touching += near ? 1 : 0;
-  }
-  if (touching > 0) {
-    throw InvalidInput("s2: coincides with s1 over a patch (" + std::to_string(touching) +
-                       " faces of s1 lie within " + std::to_string(tolerance) +
-                       " of it); the region between them is not a volume there, so diffusion cannot map "
-                       "these surfaces: use 'auto' (which falls back) or 'normal'");
+// The source cleared of its contact with the target (contact3d.hpp), and how it then lies
+// against the target. Pulling back may make the source meet itself (a sliver of marching cubes
+// turned over, a neck narrower than the clearance): then again with half the clearance, down to
+// a sixteenth (fuzz seed 5022 needed a tenth), before the contact is refused.
+struct Cleared {
+  detail::ClearedSource source;
+  detail::Nesting nesting;
+};
+
+Cleared clear_and_classify(const Points3Ref& source_vertices, const FacesRef& source_faces,
+                           const Points3Ref& target_vertices, const FacesRef& target_faces,
+                           const SurfaceIndex& target_index, double finer_edge, detail::Nesting nesting) {
+  double fraction = kClearanceFraction;
+  for (int attempt = 0;; ++attempt, fraction *= 0.5) {
+    Cleared cleared{detail::clear_contact(source_vertices, source_faces, target_vertices, target_faces, target_index,
+                                          fraction * finer_edge, kTouchFraction * finer_edge),
+                    nesting};
+    if (cleared.source.moved == 0) return cleared;
+    try {
+      cleared.nesting = detail::classify_nesting(cleared.source.vertices, source_faces, target_vertices, target_faces);
+      return cleared;
+    } catch (const InvalidInput&) {
+      if (attempt == kClearanceAttempts - 1) {
+        Index touching = 0;
+        for (const char t : cleared.source.touching) touching += t;
+        throw InvalidInput("s2: comes within " + std::to_string(fraction * finer_edge) + " of s1 over a patch (" +
+                           std::to_string(cleared.source.moved) + " vertices, " + std::to_string(touching) +
+                           " touching), and pulling s1 back from it there makes s1 intersect itself; diffusion "
+                           "cannot map these surfaces: use 'auto' (which falls back) or 'normal'");
+      }
+    }
   }
 }
 
@@ -352,17 +369,21 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
   if (target.volume < 0.0) target_out.col(1).swap(target_out.col(2));
 
   auto clock = std::chrono::steady_clock::now();
-  const detail::Nesting nesting =
-      detail::classify_nesting(source_vertices, source_out, target_vertices, target_out);
+  detail::Nesting nesting = detail::classify_nesting(source_vertices, source_out, target_vertices, target_out);
   if (nesting == detail::Nesting::disjoint) {
     throw InvalidInput("s2: diffusion mapping needs surfaces that overlap (these lie apart)");
   }
   const SurfaceIndex target_index(target_vertices, target_faces);
-  require_no_touching_patch(source_vertices, source_faces, target_index,
-                            kTouchFraction * std::min(source.mean_edge, target.mean_edge));
+  const double finer_edge = std::min(source.mean_edge, target.mean_edge);
+  const Cleared cleared_pair = clear_and_classify(source_vertices, source_out, target_vertices, target_out,
+                                                  target_index, finer_edge, nesting);
+  const detail::ClearedSource& cleared = cleared_pair.source;
+  nesting = cleared_pair.nesting;
+  // From here on the source is the cleared one: it bounds the region that is meshed and solved.
+  const Points3& source_region = cleared.vertices;
   std::unique_ptr<detail::CrossingRegion> crossing;
   if (nesting == detail::Nesting::crossing) {
-    crossing = std::make_unique<detail::CrossingRegion>(source_vertices, source_out, target_vertices, target_out);
+    crossing = std::make_unique<detail::CrossingRegion>(source_region, source_out, target_vertices, target_out);
   }
 
   // Sizes: the input spacing at each surface, growing by a tenth of the distance from it, never
@@ -371,7 +392,8 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
   // linearly with the element size in the bulk, and removing slivers (exude) buys more accuracy
   // than it costs time.
   const double volume = crossing ? crossing->volume() : std::abs(std::abs(target.volume) - std::abs(source.volume));
-  const double gap = volume / (0.5 * (source.area + target.area));
+  // Where the surfaces touch, they bound no region: leave that part out of the mean.
+  const double gap = volume / std::max(0.5 * (source.area + target.area) - cleared.near_area, 0.05 * source.area);
   detail::ShellMeshCriteria criteria;
   criteria.cell_size = options.mesh_size > 0.0 ? options.mesh_size : 0.25 * gap;
   // Near the source, where the streamlines start, the elements stay within a fraction of the
@@ -407,7 +429,7 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
       mesh = detail::mesh_in_child(
           [&] {
             return crossing ? crossing->mesh(criteria)
-                            : detail::mesh_shell(source_vertices, source_out, target_vertices, target_out,
+                            : detail::mesh_shell(source_region, source_out, target_vertices, target_out,
                                                  nesting == detail::Nesting::source_inside, criteria);
           },
           "meshing the region between the surfaces");
@@ -451,7 +473,7 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
     const int i = static_cast<int>(source_facets[k] % 4);
     for (int j = 1; j < 4; ++j) facets(static_cast<Index>(k), j - 1) = mesh.tetrahedra(t, (i + j) % 4);
   }
-  const detail::TriangleHits starts = detail::closest_on_triangles(mesh.vertices, facets, source_vertices);
+  const detail::TriangleHits starts = detail::closest_on_triangles(mesh.vertices, facets, source_region);
 
   const Tracer tracer(mesh, solution.potential, kind);
   const Index ns = source_vertices.rows();
@@ -475,6 +497,11 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
     for (std::size_t k = 0; k < reached.size(); ++k) queries.row(static_cast<Index>(k)) = exits.row(reached[k]);
     const SurfaceHits ends = target_index.closest_points(queries);
     for (std::size_t k = 0; k < reached.size(); ++k) solution.ends.row(reached[k]) = ends.points.row(static_cast<Index>(k));
+  }
+  // Where the surfaces touch, the vertices map to their closest point (as 2D's contact stretches).
+  solution.touching.assign(cleared.touching.begin(), cleared.touching.end());
+  for (Index i = 0; i < ns; ++i) {
+    if (cleared.touching[i]) solution.ends.row(i) = cleared.closest.row(i);
   }
   if (options.keep_streamlines) {
     solution.streamlines.resize(ns);

@@ -179,6 +179,20 @@ Nesting classify_nesting(const Points3Ref& source_vertices, const FacesRef& sour
   }
 }
 
+std::vector<char> inside_surface(const Points3Ref& vertices, const FacesRef& faces, const Points3Ref& queries) {
+  std::vector<char> inside(static_cast<std::size_t>(queries.rows()), 0);
+  try {
+    const SurfaceMesh surface = to_surface_mesh(vertices, faces);
+    const CGAL::Side_of_triangle_mesh<SurfaceMesh, Kernel> side(surface);
+    for (Index i = 0; i < queries.rows(); ++i) {
+      inside[static_cast<std::size_t>(i)] = side(Point(queries(i, 0), queries(i, 1), queries(i, 2))) != CGAL::ON_UNBOUNDED_SIDE;
+    }
+  } catch (const CGAL::Failure_exception& e) {
+    throw GeometryError(std::string("locating points against a surface failed: ") + e.what());
+  }
+  return inside;
+}
+
 ShellMesh mesh_shell(const Points3Ref& source_vertices, const FacesRef& source_faces,
                      const Points3Ref& target_vertices, const FacesRef& target_faces, bool source_inside,
                      const ShellMeshCriteria& criteria) {

@@ -5,6 +5,7 @@
 #include <morphomap/types.hpp>
 
 #include <memory>
+#include <vector>
 
 namespace morphomap::detail {
 
@@ -13,6 +14,10 @@ namespace morphomap::detail {
 enum class Nesting { source_inside, target_inside, disjoint, crossing };
 Nesting classify_nesting(const Points3Ref& source_vertices, const FacesRef& source_faces,
                          const Points3Ref& target_vertices, const FacesRef& target_faces);
+
+// For each query point: whether it lies inside the closed, outward-oriented surface (exact
+// predicates, so points within rounding of the surface are still told apart); on it counts as inside.
+std::vector<char> inside_surface(const Points3Ref& vertices, const FacesRef& faces, const Points3Ref& queries);
 
 struct ShellMeshCriteria {
   // Target edge length: source_size + grading * (distance to the source surface) near the source,

@@ -74,6 +74,9 @@ DisplacementField3 basic(MapMethod method, const Surface& source, const Surface&
       detail::unfold(field.starts, field.ends, field.faces, source.vertices, source.faces, *source_index,
                      target.vertices, target.faces, target_index);
       field.methods.assign(field.size(), Method::diffusion);
+      for (Index i = 0; i < field.size(); ++i) {
+        if (solution.touching[static_cast<std::size_t>(i)]) field.methods[i] = Method::minimal_distance;
+      }
       break;
     }
     default:

@@ -1,11 +1,14 @@
 // Bindings of 3D diffusion mapping: the Laplace problem in the shell between two closed surfaces.
 #include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include <morphomap/laplace3d.hpp>
 
 #include "interrupt_guard.hpp"
+
+#include <algorithm>
 
 namespace py = pybind11;
 using namespace morphomap;
@@ -30,8 +33,17 @@ void bind_diffusion3d(py::module_& m) {
         seconds["mesh"] = solution.seconds.mesh;
         seconds["solve"] = solution.seconds.solve;
         seconds["trace"] = solution.seconds.trace;
-        return py::make_tuple(std::move(solution.vertices), std::move(solution.tetrahedra),
-                              std::move(solution.potential), std::move(solution.ends), streamlines, seconds);
+        py::array_t<bool> touching(static_cast<py::ssize_t>(solution.touching.size()));
+        std::copy(solution.touching.begin(), solution.touching.end(), touching.mutable_data());
+        py::dict result;
+        result["vertices"] = std::move(solution.vertices);
+        result["tetrahedra"] = std::move(solution.tetrahedra);
+        result["potential"] = std::move(solution.potential);
+        result["ends"] = std::move(solution.ends);
+        result["touching"] = touching;
+        result["streamlines"] = streamlines;
+        result["seconds"] = seconds;
+        return result;
       },
       py::arg("source_vertices"), py::arg("source_faces"), py::arg("target_vertices"), py::arg("target_faces"),
       py::arg("mesh_size"), py::arg("keep_streamlines"));

@@ -22,7 +22,10 @@ class ShellDiffusionSolution:
     potential : (V,) float
         c at the vertices: P1 finite elements with c = 1 on S1 and c = 0 on S2.
     ends : (N, 3) float
-        For each vertex of S1, where its streamline of -grad c meets S2 (NaN if it does not).
+        For each vertex of S1, where its streamline of -grad c meets S2 (NaN if it does not); for a
+        vertex that touches S2, its closest point there.
+    touching : (N,) bool
+        The vertices of S1 that touch S2 (within 1% of the finer mean edge): cut out of the region.
     streamlines : list of (K, 3) float
         With ``streamlines=True``: the polyline of each streamline, from the vertex of S1 to its end.
     seconds : dict
@@ -33,6 +36,7 @@ class ShellDiffusionSolution:
     tetrahedra: np.ndarray
     potential: np.ndarray
     ends: np.ndarray
+    touching: np.ndarray
     streamlines: list
     seconds: dict
 
@@ -58,10 +62,14 @@ def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False) -> ShellDif
         lies inside the other (the region is the shell between them) or they cross: then the
         region is both pieces of their symmetric difference (S1 outside S2, bounded by that part
         of S1 and the part of S2 inside S1; and S2 outside S1), meshed with the crossing curves
-        as edges, where c = 0. Surfaces that lie apart or coincide over a patch (a face of S1
-        within 1% of the finer mean edge of S2 at all three corners, as where frames contoured
-        on one voxel grid share faces) raise ValueError; ``map_surfaces(..., method="auto")``
-        falls back to normal mapping there.
+        as edges, where c = 0. Where the surfaces touch or coincide over a patch (as frames
+        contoured on one voxel grid do where the tissue did not move), the patch is cut out: the
+        vertices of S1 within 1% of the finer mean edge of S2 map to their closest point there
+        (``touching``), and those within half that edge are pulled back from S2 along S1's normals,
+        to half an edge away on the side their surroundings lie, before the region is meshed
+        (their streamlines start there). Surfaces that lie apart, or a contact patch that also
+        crosses S2 or that the pull-back would fold into itself, raise ValueError;
+        ``map_surfaces(..., method="auto")`` falls back to normal mapping there.
     mesh_size : float, optional
         Largest tetrahedron size. Default: a quarter of the mean gap (the region's volume over the
         mean area of the surfaces). Near each surface the mesh follows its mean edge length (or
@@ -76,6 +84,6 @@ def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False) -> ShellDif
     """
     v1, f1 = as_surface(s1, "s1")
     v2, f2 = as_surface(s2, "s2")
-    vertices, tetrahedra, potential, ends, lines, seconds = _core.solve_diffusion_3d(
-        v1, f1, v2, f2, _mesh_size(mesh_size), as_flag(streamlines, "streamlines"))
-    return ShellDiffusionSolution(vertices, tetrahedra, potential, ends, list(lines), dict(seconds))
+    solved = _core.solve_diffusion_3d(v1, f1, v2, f2, _mesh_size(mesh_size), as_flag(streamlines, "streamlines"))
+    return ShellDiffusionSolution(solved["vertices"], solved["tetrahedra"], solved["potential"], solved["ends"],
+                                  solved["touching"], list(solved["streamlines"]), dict(solved["seconds"]))

@@ -99,8 +99,10 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None) -> D
         directions, to its nearest intersection with ``s2``; NaN where it meets nothing.
         ``"diffusion"``: streamlines of Laplace's equation in the region between the surfaces
         (c = 1 on S1, 0 on S2) from each vertex to S2; nested or crossing surfaces (see
-        :func:`solve_diffusion_3d`), without self-intersections, and not coinciding over a
-        patch. The streamlines never cross, but their discrete form can turn over a sliver
+        :func:`solve_diffusion_3d`), without self-intersections. Where the surfaces touch or
+        coincide over a patch, its vertices map to their closest point (``field.method`` says
+        ``"minimal_distance"``) and the rest of the region is meshed with S1 pulled back half an
+        edge from S2 there. The streamlines never cross, but their discrete form can turn over a sliver
         narrower than the mesh's distance to the surfaces: the ends of such triangles are moved
         into the kernel of their image fan on S2 (a few tenths of an edge at most in the fuzz
         suite), so that the field has no folds where that succeeds; ``quality`` counts any left.

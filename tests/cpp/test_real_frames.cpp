@@ -176,21 +176,38 @@ void debris_inward_and_unused_vertices_are_named() {
   }
 }
 
-void auto_answers_where_diffusion_cannot_mesh() {
-  // S2 is S1 with its upper half pushed out: the lower half coincides, which no tetrahedral mesh
-  // of the region can follow; normal mapping folds there or not, auto must still answer.
+void surfaces_that_coincide_over_a_patch_map() {
+  // S2 is S1 with its upper half pushed out: the lower half coincides, where the region between
+  // them has no volume. Auto answers; diffusion cuts the shared patch out: its vertices stay where
+  // they are, the others follow streamlines, and no triangle folds.
   morphomap_test::Surface s1 = scaled(icosphere(3), 1, 1, 1), s2 = s1;
   for (Index i = 0; i < s2.vertices.rows(); ++i) {
     if (s2.vertices(i, 2) > 0.2) s2.vertices.row(i) *= 1.0 + (s2.vertices(i, 2) - 0.2);
   }
-  SurfaceMappingOptions options;
-  options.method = MapMethod::automatic;
-  const auto field = morphomap::map_surfaces(s1.vertices, s1.faces, s2.vertices, s2.faces, options);
-  bool valid = true;
-  for (Index i = 0; i < field.size(); ++i) valid = valid && field.valid(i);
-  CHECK(valid);
   const morphomap::SurfaceIndex on_s2(s2.vertices, s2.faces);
-  CHECK(on_s2.closest_points(field.ends).distances.maxCoeff() < 1e-9);
+  for (const MapMethod method : {MapMethod::automatic, MapMethod::diffusion}) {
+    SurfaceMappingOptions options;
+    options.method = method;
+    const auto field = morphomap::map_surfaces(s1.vertices, s1.faces, s2.vertices, s2.faces, options);
+    bool valid = true;
+    for (Index i = 0; i < field.size(); ++i) valid = valid && field.valid(i);
+    CHECK(valid);
+    CHECK(on_s2.closest_points(field.ends).distances.maxCoeff() < 1e-9);
+    if (method != MapMethod::diffusion) continue;
+    bool shared_stay = true, others_follow_streamlines = true;
+    for (Index i = 0; i < field.size(); ++i) {
+      if (s1.vertices(i, 2) <= 0.2) {
+        shared_stay = shared_stay && field.methods[i] == Method::minimal_distance &&
+                      (field.ends.row(i) - field.starts.row(i)).norm() < 1e-12;
+      } else if (s1.vertices(i, 2) > 0.4) {
+        others_follow_streamlines = others_follow_streamlines && field.methods[i] == Method::diffusion &&
+                                    (field.ends.row(i) - field.starts.row(i)).norm() > 1e-3;
+      }
+    }
+    CHECK(shared_stay);
+    CHECK(others_follow_streamlines);
+    CHECK(morphomap::quality(field, s1.vertices, s1.faces, s2.vertices, s2.faces).folds == 0);
+  }
 }
 
 void an_interrupt_stops_a_mapping() {
@@ -210,7 +227,7 @@ int main() {
   touching_circles_are_a_split();
   several_loops_and_self_intersections_are_named();
   debris_inward_and_unused_vertices_are_named();
-  auto_answers_where_diffusion_cannot_mesh();
+  surfaces_that_coincide_over_a_patch_map();
   an_interrupt_stops_a_mapping();
   TEST_MAIN_END();
 }

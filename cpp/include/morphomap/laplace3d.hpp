@@ -30,15 +30,23 @@ struct ShellDiffusionSolution {
                            // target surface (NaN if it does not)
   std::vector<Points3> streamlines;  // with keep_streamlines: the source vertex, the streamline
                                      // from the mesh boundary, and the end (NaN if lost)
+  std::vector<char> touching;        // per source vertex: it touches the target (its end is its
+                                     // closest point there, not a streamline's)
   ShellDiffusionTimings seconds;
 };
 
 // Both surfaces closed, edge-manifold and consistently oriented (either way round). The region: the
 // shell between them when one lies inside the other (which one is found); when they cross, the
 // pieces of their symmetric difference (S1 outside S2, S2 outside S1), each bounded by parts of
-// both, meshed together with the crossing curves as mesh edges (c = 0 on them). Surfaces that lie
-// apart, intersect themselves or coincide over a patch (a face of S1 within 1% of the finer mean
-// edge of S2 at all three corners): InvalidInput. Mesh_3 runs in a child process where fork exists
+// both, meshed together with the crossing curves as mesh edges (c = 0 on them). Where the surfaces
+// touch or coincide over a patch (as frames contoured on one voxel grid do where the tissue did
+// not move), the patch is cut out: source vertices within 1% of the finer mean edge of the target
+// map to their closest point there (`touching`), and the source vertices within half that edge
+// are pulled back from the target along the source's normals, to half an edge away on the side
+// their surroundings lie, before the region is meshed; their streamlines start from there. Such
+// a patch whose surroundings lie on both sides of the target (the surfaces also cross there), or
+// that the pull-back would fold into itself: InvalidInput. Surfaces that lie apart or intersect
+// themselves: InvalidInput. Mesh_3 runs in a child process where fork exists
 // (it can crash on valid input); a crash there is retried twice with other random choices and
 // slightly finer sizes, then a GeometryError. Streamlines start on the
 // mesh boundary at the closest point to each source vertex and follow the recovered, linearly
