@@ -61,6 +61,28 @@ Points3 smoothed_normals(const Points3Ref& vertices, const FacesRef& faces, cons
   return normals;
 }
 
+// Marching cubes leaves slivers far thinner than their edges; corners of one that are pulled by
+// different amounts turn it over, and the surface then meets itself. Such a face's corners are
+// moved back half way towards where they were, until no face has turned (at most 10 rounds).
+void keep_faces_facing(const Points3Ref& before, const FacesRef& faces, Points3& after) {
+  constexpr int kRounds = 10;
+  std::vector<Index> back;
+  for (int round = 0; round < kRounds; ++round) {
+    back.clear();
+    for (Index f = 0; f < faces.rows(); ++f) {
+      const Index a = faces(f, 0), b = faces(f, 1), c = faces(f, 2);
+      const Vec3 was = (before.row(b) - before.row(a)).cross(before.row(c) - before.row(a)).transpose();
+      const Vec3 now = (after.row(b) - after.row(a)).cross(after.row(c) - after.row(a)).transpose();
+      if (now.dot(was) > 0.0) continue;
+      back.insert(back.end(), {a, b, c});
+    }
+    if (back.empty()) return;
+    std::sort(back.begin(), back.end());
+    back.erase(std::unique(back.begin(), back.end()), back.end());
+    for (const Index v : back) after.row(v) = 0.5 * (after.row(v) + before.row(v));
+  }
+}
+
 [[noreturn]] void refuse(Index faces, double tolerance, const std::string& why) {
   throw InvalidInput("s2: coincides with s1 over a patch (" + std::to_string(faces) + " faces of s1 lie within " +
                      std::to_string(tolerance) + " of it) " + why +
@@ -180,6 +202,7 @@ ClearedSource clear_contact(const Points3Ref& source_vertices, const FacesRef& s
       ++cleared.moved;
     }
   }
+  keep_faces_facing(source_vertices, source_faces, cleared.vertices);
   return cleared;
 }
 

@@ -318,7 +318,7 @@ class Tracer {
 // The source cleared of its contact with the target (contact3d.hpp), and how it then lies
 // against the target. Pulling back may make the source meet itself (a sliver of marching cubes
 // turned over, a neck narrower than the clearance): then again with half the clearance, down to
-// a sixteenth (fuzz seed 5022 needed a tenth), before the contact is refused.
+// 1/32 of the edge (fuzz seed 5022 needed 1/16), before the contact is refused.
 struct Cleared {
   detail::ClearedSource source;
   detail::Nesting nesting;
