@@ -151,6 +151,33 @@ Points2 cut_open(const ArcCurve& curve, double a) {
   return out;
 }
 
+// best_anchor's shift to within a hair: it is found on a grid of m samples, and a pinned start
+// point that is off by a fraction of a sample turns the whole matching by that much. Golden-section
+// search of the same sum of squared displacements over one grid step either side.
+double refined_anchor(const ArcCurve& source, const ArcCurve& target, double anchor) {
+  Index m = 64;
+  while (m < 2 * source.size()) m *= 2;
+  std::vector<Vec2> s(m);
+  for (Index j = 0; j < m; ++j) s[j] = source.point_at(source.length() * j / m);
+  auto cost = [&](double a) {
+    double sum = 0.0;
+    for (Index j = 0; j < m; ++j) sum += (s[j] - target.point_at(a + target.length() * j / m)).squaredNorm();
+    return sum;
+  };
+  const double ratio = 0.5 * (std::sqrt(5.0) - 1.0), bin = target.length() / m;
+  double lo = anchor - bin, hi = anchor + bin;
+  double x1 = hi - ratio * (hi - lo), x2 = lo + ratio * (hi - lo), f1 = cost(x1), f2 = cost(x2);
+  for (int iteration = 0; iteration < 20; ++iteration) {  // 0.618^20: 1e-4 of a step
+    if (f1 < f2) {
+      hi = x2, x2 = x1, f2 = f1, x1 = hi - ratio * (hi - lo), f1 = cost(x1);
+    } else {
+      lo = x1, x1 = x2, f1 = f2, x2 = lo + ratio * (hi - lo), f2 = cost(x2);
+    }
+  }
+  const double best = 0.5 * (lo + hi);
+  return cost(best) <= cost(anchor) ? best : anchor;
+}
+
 // "optimal" on one job. A piece (or open curves) is matched between its two ends. Whole closed
 // curves are cut open at the first start point and at the point of the target that the best
 // cyclic shift puts there (best_anchor), matched once round, then cut again at the start point
@@ -176,7 +203,8 @@ Points2 optimal_ends(const Job& job, double stretch_weight) {
     return ends;
   };
   MonotoneMatch first, second;
-  const double anchor = best_anchor(source, target, 1) + source.arc(job.start_rows[0]) * target.length() / source.length();
+  const double anchor = refined_anchor(source, target, best_anchor(source, target, 1)) +
+                        source.arc(job.start_rows[0]) * target.length() / source.length();
   Points2 ends = pass(0, anchor, first);
   if (count < 2) return ends;
   const Index half = count / 2;

@@ -96,9 +96,12 @@ def _choose(cheap, expensive, skip_below, workers):
     if not (skip_below >= 0 and math.isfinite(skip_below)):
         raise ValueError(f"skip_below: must be a finite number >= 0, got {skip_below}")
     workers = (os.cpu_count() or 1) if workers is None else as_count(workers, "workers", 1)
-    results = []
+    # The first candidate runs here, alone: the first call into the core from several threads at
+    # once can deadlock on the one-time set-up of its array conversions (a function-local static
+    # that waits for a thread which waits for the GIL).
+    results = [_run(cheap[0])]
     with ThreadPoolExecutor(max_workers=workers) as pool:
-        results += list(pool.map(_run, cheap))
+        results += list(pool.map(_run, cheap[1:]))
         good = [c.qm for _, c in results if c.status == "admissible"]
         if skip_below > 0 and good and min(good) <= skip_below:
             results += [(None, Candidate(name, math.nan, math.nan, math.nan, -1, -1, 0.0,
