@@ -43,12 +43,23 @@ double orient(const Vec2& a, const Vec2& b, const Vec2& c) {
   return (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
 }
 
-// The segments a0-a1 and b0-b1 cross at a point inside both (touching does not count).
+// p, on the line through a and b, lies within the segment a-b.
+bool within(const Vec2& a, const Vec2& b, const Vec2& p) {
+  return std::min(a.x(), b.x()) <= p.x() && p.x() <= std::max(a.x(), b.x()) && std::min(a.y(), b.y()) <= p.y() &&
+         p.y() <= std::max(a.y(), b.y());
+}
+
+// The segments a0-a1 and b0-b1 meet other than at a shared end point: the definition of
+// count_crossings (a start point lying on the neighbouring vector counts, as on pixel-grid frames
+// where both run along one row).
 bool cross(const Vec2& a0, const Vec2& a1, const Vec2& b0, const Vec2& b1) {
   const double d1 = orient(b0, b1, a0), d2 = orient(b0, b1, a1);
-  if (!((d1 < 0 && d2 > 0) || (d1 > 0 && d2 < 0))) return false;
   const double d3 = orient(a0, a1, b0), d4 = orient(a0, a1, b1);
-  return (d3 < 0 && d4 > 0) || (d3 > 0 && d4 < 0);
+  if (((d1 < 0 && d2 > 0) || (d1 > 0 && d2 < 0)) && ((d3 < 0 && d4 > 0) || (d3 > 0 && d4 < 0))) return true;
+  auto touches = [](double d, const Vec2& p, const Vec2& s0, const Vec2& s1) {
+    return d == 0.0 && p != s0 && p != s1 && within(s0, s1, p);
+  };
+  return touches(d1, a0, b0, b1) || touches(d2, a1, b0, b1) || touches(d3, b0, a0, a1) || touches(d4, b1, a0, a1);
 }
 
 // One level: the starts `rows` (indices into Problem::starts, increasing), the target sampled at
