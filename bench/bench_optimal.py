@@ -113,7 +113,7 @@ def scaling(cases, sizes, peer_sizes):
             _, t_theirs = timed(lambda: elastic(a, b), 1)
             print(row([str(n), f"{t_ours:.3f}", f"{t_theirs:.2f}", f"{t_theirs / t_ours:.0f}x"]))
         else:
-            print(row([str(n), f"{t_ours:.3f}", "not run (hours)", ""]))
+            print(row([str(n), f"{t_ours:.3f}", "not run", ""]))
 
 
 def auto_best_optimal(cases):
