@@ -96,9 +96,9 @@ def _choose(cheap, expensive, skip_below, workers):
     if not (skip_below >= 0 and math.isfinite(skip_below)):
         raise ValueError(f"skip_below: must be a finite number >= 0, got {skip_below}")
     workers = (os.cpu_count() or 1) if workers is None else as_count(workers, "workers", 1)
-    # The first candidate runs here, alone: the first call into the core from several threads at
-    # once can deadlock on the one-time set-up of its array conversions (a function-local static
-    # that waits for a thread which waits for the GIL).
+    # The first candidate runs here, alone: first calls into the core from several threads at once
+    # deadlocked on the one-time set-up of its array conversions (a function-local static waiting
+    # for a thread that waits for the GIL; seen with a module built against an older pybind11).
     results = [_run(cheap[0])]
     with ThreadPoolExecutor(max_workers=workers) as pool:
         results += list(pool.map(_run, cheap[1:]))
