@@ -24,6 +24,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kCrossing = 1e6;  // added where two consecutive vectors cross
 constexpr Index kThinning = 4;     // starts per level
 constexpr Index kCoarsest = 256;   // the full grid is searched at or below this many starts
+constexpr Index kRecent = 3;       // vectors back along the path checked for crossings
 
 // The problem of one call: start points with their arc positions, the two pieces' lengths, the
 // virtual vectors at both ends, and the weights.
@@ -100,6 +101,21 @@ bool solve_level(const Problem& p, const Level& level, std::vector<Index>& path,
 
   std::vector<std::vector<double>> cost(count);
   std::vector<std::vector<std::int32_t>> back(count);
+  // Whether the vector p -> end crosses one of the kRecent vectors before it on the best path
+  // into (r - 1, kp): its neighbour exactly, the ones further back as that path has them (the
+  // DP's state holds one vector; staircase contours cross two or three apart).
+  auto crosses_recent = [&](const Level& lv, const std::vector<std::vector<std::int32_t>>& from_row, Index r,
+                            Index kp, const Vec2& point, const Vec2& end) {
+    Index k_back = kp;
+    for (Index d = 1; d <= kRecent && r - d >= 0; ++d) {
+      if (d > 1) {
+        k_back = from_row[r - d + 1][k_back - lv.lo[r - d + 1]];
+        if (k_back < 0) break;
+      }
+      if (cross(p.starts.row(lv.rows[r - d]).transpose(), q[k_back], point, end)) return true;
+    }
+    return false;
+  };
   for (Index r = 0; r < count; ++r) {
     if ((r & 63) == 0) detail::check_interrupt();
     const Index lo = level.lo[r], hi = level.hi[r];
@@ -124,7 +140,8 @@ bool solve_level(const Problem& p, const Level& level, std::vector<Index>& path,
         const double before = first ? 0.0 : cost[r - 1][kp - plo];
         if (before == kInf) continue;
         double c = before + stretch(step_length * (k - kp), dl);
-        if (!first && cross(prev_point, q[kp], pi, q[k])) c += kCrossing;
+        if (!(c < best)) continue;  // the crossing tests only where the step could win
+        if (!first && crosses_recent(level, back, r, kp, pi, q[k])) c += kCrossing;
         if (c < best) best = c, arg = kp;
       }
       if (arg >= 0) cost[r][k - lo] = best + displacement, back[r][k - lo] = static_cast<std::int32_t>(arg);

@@ -32,10 +32,11 @@ struct MonotoneMatch {
 // l_j, L_j the arc lengths between consecutive starts / ends, alpha = target length / source
 // length (so that the uniform map has no stretch), g^2 the mean squared distance from the starts
 // to the target (at least the squared mean spacing of the starts, so that touching pieces stay
-// well posed), w = stretch_weight (the paper's QM1 term; 0: nearest monotone matching). A
-// transition whose two consecutive vectors cross or touch (other than at a shared end) costs 1e6
-// more, so the path avoids them where it can; vectors further apart in the order are not checked
-// (order preservation keeps them apart on all pairs measured so far, not by construction). Each step advances by 1 .. 8 M / (n + 1) + 2 samples.
+// well posed), w = stretch_weight (the paper's QM1 term; 0: nearest monotone matching). A step
+// whose new vector crosses or touches (other than at a shared end) one of the three vectors before
+// it costs 1e6 more, so the path avoids crossings where it can: exactly for the neighbour, for the
+// two before that as the best path into the previous state has them (the state holds one vector;
+// staircase contours of masks cross two or three apart). Vectors further apart are not checked. Each step advances by 1 .. 8 M / (n + 1) + 2 samples.
 //
 // Cost: coarse to fine. The starts are thinned by 4 per level down to <= 256, where the DP runs on
 // the full grid; each finer level searches only a band of +- max(16, 8 M / (n + 1)) samples around
