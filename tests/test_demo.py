@@ -49,11 +49,19 @@ def test_demo_runs_every_algorithm_and_writes_everything(tmp_path):
         assert len(auto) == 1 and auto[0][6] == "0"  # the default workflow leaves no crossings
         assert f"auto on {pair}: vectors made by" in out
         assert (folder / "auto.png").exists() and len(mm.read_field(folder / "auto.csv")) > 0
+        # Beyond the paper: optimal and best, crossing-free, best no worse than auto.
+        for method in ("optimal", "best"):
+            row = [cells for cells in table if cells[:3] == [pair, method, "plain"]]
+            assert len(row) == 1 and row[0][6] == "0" and row[0][7] == "0", (pair, method)
+            assert (folder / f"{method}.png").stat().st_size > 10_000
+        best = [cells for cells in table if cells[:3] == [pair, "best", "plain"]][0]
+        assert float(best[5]) <= float(auto[0][5])
+        assert f"best on {pair}: the winner is" in out
     # The kidney pair is there to show crossings of plain normal mapping.
     normal = [cells for cells in table if cells[:3] == ["kidney", "normal", "plain"]][0]
     assert int(normal[6]) > 0
     assert str((tmp_path / "out").resolve()) in out
-    assert (tmp_path / "out" / "quality.csv").read_text().count("\n") == 1 + len(EXAMPLES) * 13
+    assert (tmp_path / "out" / "quality.csv").read_text().count("\n") == 1 + len(EXAMPLES) * 15
     # From images: the frames are TIFFs a user can map again with the command line; every field of
     # the table is on disk with its figure and its measures hold when recomputed.
     images = tmp_path / "out" / "images"

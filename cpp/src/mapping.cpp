@@ -6,6 +6,7 @@
 #include <morphomap/curve_queries.hpp>
 #include <morphomap/laplace.hpp>
 #include <morphomap/mapping.hpp>
+#include <morphomap/optimal.hpp>
 #include <morphomap/resample.hpp>
 #include <morphomap/transform.hpp>
 
@@ -35,11 +36,18 @@ std::string method_name(Method method) {
     case Method::reverse_normal: return "reverse_normal";
     case Method::reverse_diffusion: return "reverse_diffusion";
     case Method::reverse_uniform: return "reverse_uniform";
+    case Method::optimal: return "optimal";
+    case Method::reverse_optimal: return "reverse_optimal";
   }
   return "unknown";
 }
 
 Method reversed(Method method) {
+  switch (method) {
+    case Method::optimal: return Method::reverse_optimal;
+    case Method::reverse_optimal: return Method::optimal;
+    default: break;
+  }
   const int code = static_cast<int>(method);
   return static_cast<Method>(code < 4 ? code + 4 : code - 4);
 }
@@ -85,6 +93,7 @@ struct Settings {
   double density_threshold = 0.0;
   double contact_tolerance = -1.0;  // < 0: default_contact_tolerance
   DiffusionOptions diffusion;
+  double stretch_weight = kDefaultStretchWeight;  // "optimal"
 };
 
 bool all_rows_equal(const Points2& points) {
@@ -123,6 +132,86 @@ void put_in_order(Points2& ends, const ArcCurve& target) {
   }
 }
 
+double best_anchor(const ArcCurve& source, const ArcCurve& target, int direction);
+int relative_direction(const ArcCurve& source, const ArcCurve& target);
+
+// A closed curve cut open at arc position a: from the point there once round back to it.
+Points2 cut_open(const ArcCurve& curve, double a) {
+  a = curve.wrap(a);
+  std::vector<Vec2> rows{curve.point_at(a)};
+  for (Index v = 0; v < curve.size(); ++v) {
+    if (curve.arc(v) > a) rows.push_back(curve.points().row(v).transpose());
+  }
+  for (Index v = 0; v < curve.size(); ++v) {
+    if (curve.arc(v) < a) rows.push_back(curve.points().row(v).transpose());
+  }
+  rows.push_back(rows.front());
+  Points2 out(rows.size(), 2);
+  for (std::size_t r = 0; r < rows.size(); ++r) out.row(r) = rows[r].transpose();
+  return out;
+}
+
+// best_anchor's shift to within a hair: it is found on a grid of m samples, and a pinned start
+// point that is off by a fraction of a sample turns the whole matching by that much. Golden-section
+// search of the same sum of squared displacements over one grid step either side.
+double refined_anchor(const ArcCurve& source, const ArcCurve& target, double anchor) {
+  Index m = 64;
+  while (m < 2 * source.size()) m *= 2;
+  std::vector<Vec2> s(m);
+  for (Index j = 0; j < m; ++j) s[j] = source.point_at(source.length() * j / m);
+  auto cost = [&](double a) {
+    double sum = 0.0;
+    for (Index j = 0; j < m; ++j) sum += (s[j] - target.point_at(a + target.length() * j / m)).squaredNorm();
+    return sum;
+  };
+  const double ratio = 0.5 * (std::sqrt(5.0) - 1.0), bin = target.length() / m;
+  double lo = anchor - bin, hi = anchor + bin;
+  double x1 = hi - ratio * (hi - lo), x2 = lo + ratio * (hi - lo), f1 = cost(x1), f2 = cost(x2);
+  for (int iteration = 0; iteration < 20; ++iteration) {  // 0.618^20: 1e-4 of a step
+    if (f1 < f2) {
+      hi = x2, x2 = x1, f2 = f1, x1 = hi - ratio * (hi - lo), f1 = cost(x1);
+    } else {
+      lo = x1, x1 = x2, f1 = f2, x2 = lo + ratio * (hi - lo), f2 = cost(x2);
+    }
+  }
+  const double best = 0.5 * (lo + hi);
+  return cost(best) <= cost(anchor) ? best : anchor;
+}
+
+// "optimal" on one job. A piece (or open curves) is matched between its two ends. Whole closed
+// curves are cut open at the first start point and at the point of the target that the best
+// cyclic shift puts there (best_anchor), matched once round, then cut again at the start point
+// half way round and where the first matching took it, and matched again, so that the pinned
+// point of the first pass is free in the second; the lower energy wins.
+Points2 optimal_ends(const Job& job, double stretch_weight) {
+  if (!job.source_closed) return monotone_match(job.source, job.start_rows, job.target, stretch_weight).points;
+  const ArcCurve source(job.source, true, "c1");
+  const ArcCurve given(job.target, true, "c2");
+  const ArcCurve target(relative_direction(source, given) > 0 ? given.points() : Points2(given.points().colwise().reverse()),
+                        true, "c2");
+  const Index n = source.size();
+  const Index count = static_cast<Index>(job.start_rows.size());
+  auto pass = [&](Index first, double anchor, MonotoneMatch& match) {
+    const Index h = job.start_rows[first];
+    Points2 rotated(n + 1, 2);
+    for (Index j = 0; j <= n; ++j) rotated.row(j) = source.points().row((h + j) % n);
+    std::vector<Index> rows(count);
+    for (Index k = 0; k < count; ++k) rows[k] = (job.start_rows[(first + k) % count] - h + n) % n;
+    match = monotone_match(rotated, rows, cut_open(target, anchor), stretch_weight);
+    Points2 ends(count, 2);
+    for (Index k = 0; k < count; ++k) ends.row((first + k) % count) = match.points.row(k);
+    return ends;
+  };
+  MonotoneMatch first, second;
+  const double anchor = refined_anchor(source, target, best_anchor(source, target, 1)) +
+                        source.arc(job.start_rows[0]) * target.length() / source.length();
+  Points2 ends = pass(0, anchor, first);
+  if (count < 2) return ends;
+  const Index half = count / 2;
+  Points2 other = pass(half, anchor + first.arcs[half], second);
+  return second.energy < first.energy ? other : ends;
+}
+
 Points2 basic_ends(MapMethod method, const Job& job, const Points2& starts, const Settings& settings) {
   if (starts.rows() == 0) return Points2(0, 2);
   // A piece of the target that shrank to a point (two meetings at one place) takes all starts.
@@ -148,6 +237,8 @@ Points2 basic_ends(MapMethod method, const Job& job, const Points2& starts, cons
       put_in_order(ends, target);
       return ends;
     }
+    case MapMethod::optimal:
+      return optimal_ends(job, settings.stretch_weight);
     case MapMethod::automatic:
       break;
   }
@@ -157,6 +248,7 @@ Points2 basic_ends(MapMethod method, const Job& job, const Points2& starts, cons
 Method basic_method(MapMethod method) {
   switch (method) {
     case MapMethod::minimal_distance: return Method::minimal_distance;
+    case MapMethod::optimal: return Method::optimal;
     case MapMethod::normal: return Method::normal;
     case MapMethod::uniform: return Method::uniform;
     case MapMethod::diffusion: return Method::diffusion;
@@ -569,6 +661,7 @@ DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2,
   settings.density_threshold = options.density_threshold;
   settings.contact_tolerance = options.contact_tolerance;
   settings.diffusion = options.diffusion;
+  settings.stretch_weight = options.stretch_weight;
   Vectors v = options.reverse ? map_directed(b, a, options.method, closed, options.split, anchors, settings)
                               : map_directed(a, b, options.method, closed, options.split, anchors, settings);
   DisplacementField2 field;

@@ -22,7 +22,8 @@ MapMethod map_method(const std::string& name) {
   if (name == "diffusion") return MapMethod::diffusion;
   if (name == "uniform") return MapMethod::uniform;
   if (name == "auto") return MapMethod::automatic;
-  throw InvalidInput("method: expected 'auto', 'minimal_distance', 'normal', 'diffusion' or 'uniform', got '" + name + "'");
+  if (name == "optimal") return MapMethod::optimal;
+  throw InvalidInput("method: expected 'auto', 'minimal_distance', 'normal', 'diffusion', 'uniform' or 'optimal', got '" + name + "'");
 }
 
 }  // namespace
@@ -32,7 +33,7 @@ void bind_mapping(py::module_& m) {
       "map_curves",
       [](const Points2Ref& c1, const Points2Ref& c2, const std::string& method, bool closed, Index n,
          bool reverse, bool transform, bool split, std::optional<Vec2> anchor, double density_threshold,
-         double contact_tolerance, double mesh_size, double mesh_fraction) {
+         double contact_tolerance, double mesh_size, double mesh_fraction, double stretch_weight) {
         CurveMappingOptions options;
         options.method = map_method(method);
         options.closed = closed;
@@ -45,6 +46,7 @@ void bind_mapping(py::module_& m) {
         options.contact_tolerance = contact_tolerance;
         options.diffusion.mesh_size = mesh_size;
         options.diffusion.mesh_fraction = mesh_fraction;
+        options.stretch_weight = stretch_weight;
         DisplacementField2 field;
         InterruptGuard interruptible;
         {
@@ -56,7 +58,8 @@ void bind_mapping(py::module_& m) {
       py::arg("c1"), py::arg("c2"), py::arg("method"), py::arg("closed"), py::arg("n"),
       py::arg("reverse"), py::arg("transform"), py::arg("split"), py::arg("anchor"),
       py::arg("density_threshold"), py::arg("contact_tolerance"), py::arg("mesh_size"),
-      py::arg("mesh_fraction"));
+      py::arg("mesh_fraction"), py::arg("stretch_weight") = kDefaultStretchWeight);
+  m.attr("DEFAULT_STRETCH_WEIGHT") = kDefaultStretchWeight;
 
   m.def(
       "solve_diffusion",

@@ -97,6 +97,10 @@ def _map(args, parser) -> int:
     where = "" if args.output == "-" else f"; field written to {args.output}"
     where += f", plot to {args.plot}" if args.plot else ""
     print(_summary(field, q) + where, file=sys.stderr)
+    if field.candidates is not None:  # --method best: every candidate it tried
+        from .best import candidate_table
+
+        print(candidate_table(field), file=sys.stderr)
     return 0
 
 

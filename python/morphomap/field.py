@@ -8,7 +8,10 @@ from ._validate import as_faces, as_flag, as_points
 
 #: Names of the basic algorithms; ``reverse_`` ones ran from C2 to C1 and were flipped.
 BASIC_METHODS = ("minimal_distance", "normal", "diffusion", "uniform")
-METHOD_NAMES = BASIC_METHODS + tuple(f"reverse_{name}" for name in BASIC_METHODS)
+#: In the core's code order (files store the codes): the paper's four, their reverse forms, then
+#: the order-preserving ``"optimal"`` matching (beyond the paper) and its reverse.
+METHOD_NAMES = (BASIC_METHODS + tuple(f"reverse_{name}" for name in BASIC_METHODS)
+                + ("optimal", "reverse_optimal"))
 
 
 def _frozen(array: np.ndarray) -> np.ndarray:
@@ -32,8 +35,12 @@ class DisplacementField:
         False where the row is NaN.
     method : (M,) str
         The basic algorithm that produced each vector (``"minimal_distance"``, ``"normal"``,
-        ``"diffusion"``, ``"uniform"``), with ``"reverse_"`` before it where the vector was found
-        from C2 back to C1 (the paper's reverse mapping, e.g. ``"reverse_diffusion"``).
+        ``"diffusion"``, ``"uniform"``, ``"optimal"``), with ``"reverse_"`` before it where the
+        vector was found from C2 back to C1 (the paper's reverse mapping, e.g.
+        ``"reverse_diffusion"``).
+    candidates : tuple of Candidate or None
+        ``method="best"`` only: every candidate it tried, with its quality, crossings (folds in
+        3D), misses and seconds, and which one won (see :mod:`morphomap.best`); None otherwise.
     faces : (F, 3) int64 or None
         3D only: the connectivity of the start points.
     source : (N, 2) float or None
@@ -45,9 +52,9 @@ class DisplacementField:
     Vectors are in the order of the points of the curve or surface the algorithm mapped from.
     """
 
-    __slots__ = ("_starts", "_ends", "_method", "_faces", "_source", "_closed")
+    __slots__ = ("_starts", "_ends", "_method", "_faces", "_source", "_closed", "_candidates")
 
-    def __init__(self, starts, ends, method, faces=None, *, source=None, closed=True):
+    def __init__(self, starts, ends, method, faces=None, *, source=None, closed=True, candidates=None):
         starts = np.asarray(starts)
         dim = starts.shape[1] if starts.ndim == 2 else 2
         starts = as_points(starts, "starts", dim, allow_nan=True)
@@ -70,6 +77,7 @@ class DisplacementField:
         self._faces = None if faces is None else _frozen(as_faces(faces, "faces", len(starts)))
         self._source = None if source is None else _frozen(as_points(source, "source", 2))
         self._closed = as_flag(closed, "closed")
+        self._candidates = None if candidates is None else tuple(candidates)
 
     @classmethod
     def _from_core(cls, starts, ends, methods, faces=None, **source):
@@ -107,6 +115,15 @@ class DisplacementField:
     @property
     def closed(self) -> bool:
         return self._closed
+
+    @property
+    def candidates(self):
+        return self._candidates
+
+    def _with_candidates(self, candidates) -> "DisplacementField":
+        """The same field carrying the table of ``method="best"``."""
+        return DisplacementField(self._starts, self._ends, self._method, self._faces, source=self._source,
+                                 closed=self._closed, candidates=candidates)
 
     def at(self, points, source=None, *, closed=None, return_distances=False):
         """The displacement at ``points`` of the source boundary, whatever made the field.

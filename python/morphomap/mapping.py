@@ -10,7 +10,7 @@ from . import _core
 from ._validate import as_choice, as_count, as_flag, as_length, as_point, as_points
 from .field import DisplacementField
 
-CURVE_METHODS = ("auto", "minimal_distance", "normal", "diffusion", "uniform")
+CURVE_METHODS = ("auto", "minimal_distance", "normal", "diffusion", "uniform", "optimal", "best")
 
 
 def _threshold(value) -> float:
@@ -25,7 +25,8 @@ def _threshold(value) -> float:
 
 def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, transform=False,
                split=True, anchor=None, density_threshold=None, contact_tolerance=None,
-               mesh_size=None, mesh_fraction=0.02) -> DisplacementField:
+               mesh_size=None, mesh_fraction=0.02, stretch_weight=None, skip_below=None,
+               workers=None) -> DisplacementField:
     """Map curve ``c1`` (time t) onto curve ``c2`` (time t + dt).
 
     Parameters
@@ -33,7 +34,7 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
     c1, c2 : (N, 2) float
         The curves, both closed unless ``closed=False`` (open curves are expected to run the same
         way: start maps towards start).
-    method : {"auto", "minimal_distance", "normal", "diffusion", "uniform"}
+    method : {"auto", "minimal_distance", "normal", "diffusion", "uniform", "optimal", "best"}
         ``"minimal_distance"``: each start point to its closest point on C2.
         ``"normal"``: the line through each start point along its normal, both directions, to its
         nearest intersection with C2; NaN where it meets nothing.
@@ -50,6 +51,21 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
         the normal mapping if it missed nothing (crossings and all), else minimal distance.
         ``field.method`` tells which algorithm made each vector (``"reverse_diffusion"`` and
         so on for vectors found from C2).
+        ``"optimal"`` (beyond the paper): an order-preserving matching of each pair of segments
+        between split points (crossings and contact stretches, as above), or of the whole closed
+        curves cut open where the best cyclic shift puts C1's first point: the ends follow C2 in
+        the order of the start points and reach all of it, found by dynamic programming to
+        minimise ``sum |p_i - P_i|^2 / g^2 + stretch_weight * sum (L_i / (alpha l_i) - 1)^2``
+        (g^2: the mean squared distance from the start points to C2; the second sum is the
+        paper's QM1 term over consecutive vectors). The ends are chosen among 4 to 8 equally
+        spaced positions on C2 per start point (the matching's resolution); coarse to fine, so
+        that 10^4 points per curve take well under a second. See ``monotone_match`` in the C++
+        header ``morphomap/optimal.hpp``.
+        ``"best"`` (beyond the paper): runs every candidate — normal, minimal distance, diffusion,
+        each plain, reversed, transformed and both, ``"optimal"`` and ``"auto"`` — and returns
+        the one without crossings or misses of lowest QM (:func:`morphomap.best.map_best`);
+        ``field.candidates`` is the table of them all, ``field.method`` names the winner's
+        algorithm per vector.
     n : int, optional
         Resample both curves to ``n`` equally spaced points first (linear, the paper's
         preprocessing); by default the given points of the source curve are the start points.
@@ -84,6 +100,12 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
         Default: 1% of the finer of the two curves' median point spacings; 0: exact contact only.
     mesh_size, mesh_fraction : float, optional
         The diffusion mesh (also within ``"auto"``), as in :func:`solve_diffusion`.
+    stretch_weight : float, optional
+        ``"optimal"`` (also within ``"best"``): the weight of the stretch term against the
+        squared displacements, default 10 (``_core.DEFAULT_STRETCH_WEIGHT``); 0 gives the
+        nearest order-preserving matching, large values the piecewise uniform one.
+    skip_below, workers : optional
+        ``"best"`` only: see :func:`morphomap.best.map_best`.
 
     Both curves must be simple: one loop each, not meeting itself (``ValueError`` naming the
     curve otherwise, with the count; :func:`split_components` separates the loops of several
@@ -95,6 +117,18 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
     """
     closed = as_flag(closed, "closed")
     method = as_choice(method, "method", CURVE_METHODS)
+    if method == "best":
+        from .best import map_best
+
+        if as_flag(reverse, "reverse") or as_flag(transform, "transform"):
+            raise ValueError("reverse/transform: method 'best' tries the reversed and transformed forms itself; "
+                             "leave both False")
+        return map_best(c1, c2, closed=closed, n=n, split=split, anchor=anchor,
+                        density_threshold=density_threshold, contact_tolerance=contact_tolerance,
+                        mesh_size=mesh_size, mesh_fraction=mesh_fraction, stretch_weight=stretch_weight,
+                        skip_below=skip_below, workers=workers)
+    if skip_below is not None or workers is not None:
+        raise ValueError("skip_below/workers: only for method 'best'")
     count = 0 if n is None else as_count(n, "n", 3 if closed else 2)
     if anchor is not None:
         anchor = as_point(anchor, "anchor")
@@ -103,5 +137,6 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
         c1, as_points(c2, "c2"), method, closed, count,
         as_flag(reverse, "reverse"), as_flag(transform, "transform"), as_flag(split, "split"), anchor,
         _threshold(density_threshold), as_length(contact_tolerance, "contact_tolerance", -1.0, allow_zero=True),
-        as_length(mesh_size, "mesh_size", 0.0), as_length(mesh_fraction, "mesh_fraction", 0.02))
+        as_length(mesh_size, "mesh_size", 0.0), as_length(mesh_fraction, "mesh_fraction", 0.02),
+        as_length(stretch_weight, "stretch_weight", _core.DEFAULT_STRETCH_WEIGHT, allow_zero=True))
     return DisplacementField._from_core(starts, ends, codes, source=c1, closed=closed)

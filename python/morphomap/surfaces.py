@@ -10,7 +10,7 @@ from . import _core
 from ._validate import as_choice, as_faces, as_flag, as_length, as_points
 from .field import DisplacementField
 
-SURFACE_METHODS = ("minimal_distance", "normal", "diffusion", "auto")
+SURFACE_METHODS = ("minimal_distance", "normal", "diffusion", "auto", "best")
 
 
 def as_surface(value, name: str) -> tuple[np.ndarray, np.ndarray]:
@@ -85,7 +85,8 @@ def surface_normals(vertices, faces) -> np.ndarray:
     return _core.vertex_normals(vertices, as_faces(faces, "faces", len(vertices)))
 
 
-def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None) -> DisplacementField:
+def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None, skip_below=None,
+                 workers=None) -> DisplacementField:
     """Map closed surface ``s1`` (time t) onto closed surface ``s2`` (time t + dt).
 
     Parameters
@@ -93,7 +94,7 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None) -> D
     s1, s2 : trimesh.Trimesh or (vertices (V, 3) float, faces (F, 3) int)
         Closed, consistently oriented triangle surfaces: every edge used by exactly two faces in
         opposite directions, finite coordinates, no zero-area face.
-    method : {"normal", "minimal_distance", "diffusion", "auto"}
+    method : {"normal", "minimal_distance", "diffusion", "auto", "best"}
         ``"minimal_distance"``: each vertex of ``s1`` to its closest point on ``s2``.
         ``"normal"``: the line through each vertex along its angle-weighted normal, both
         directions, to its nearest intersection with ``s2``; NaN where it meets nothing.
@@ -109,12 +110,17 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None) -> D
         ``"auto"``: normal mapping; if a normal misses or a triangle's image is turned over (see
         :func:`quality`, ``folds``), reverse diffusion for the whole surface instead (the field
         then starts from the vertices of ``s2``; ``field.method`` tells).
+        ``"best"`` (beyond the paper): normal, minimal distance and diffusion, each plain and
+        reversed, and ``"auto"``; the one without folds or misses of lowest QM, with the table
+        of them all in ``field.candidates`` (:func:`morphomap.best.map_best_surfaces`).
     reverse : bool
         Map S2 -> S1 with the chosen algorithm and flip the vectors: starts lie on S1, ends on S2,
         in the order of S2's vertices, and ``field.faces`` are S2's faces.
     mesh_size : float, optional
         The tetrahedral mesh of diffusion mapping (also within ``"auto"``), as in
         :func:`solve_diffusion_3d`.
+    skip_below, workers : optional
+        ``"best"`` only: see :mod:`morphomap.best`.
 
     Returns
     -------
@@ -123,6 +129,14 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None) -> D
     """
     method = as_choice(method, "method", SURFACE_METHODS)
     reverse = as_flag(reverse, "reverse")
+    if method == "best":
+        from .best import map_best_surfaces
+
+        if reverse:
+            raise ValueError("reverse: method 'best' tries the reversed forms itself; leave it False")
+        return map_best_surfaces(s1, s2, mesh_size=mesh_size, skip_below=skip_below, workers=workers)
+    if skip_below is not None or workers is not None:
+        raise ValueError("skip_below/workers: only for method 'best'")
     v1, f1 = as_surface(s1, "s1")
     v2, f2 = as_surface(s2, "s2")
     starts, ends, codes, faces = _core.map_surfaces(v1, f1, v2, f2, method, reverse,

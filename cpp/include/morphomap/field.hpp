@@ -19,10 +19,12 @@ enum class Method : std::int8_t {
   reverse_normal = 5,
   reverse_diffusion = 6,
   reverse_uniform = 7,
+  optimal = 8,  // beyond the paper: the order-preserving matching (optimal.hpp)
+  reverse_optimal = 9,
 };
-constexpr int kMethodCount = 8;
+constexpr int kMethodCount = 10;
 
-// "minimal_distance", "normal", "diffusion", "uniform", and "reverse_" before each.
+// "minimal_distance", "normal", "diffusion", "uniform", "optimal", and "reverse_" before each.
 std::string method_name(Method method);
 
 // The same algorithm run the other way: normal <-> reverse_normal, and so on.

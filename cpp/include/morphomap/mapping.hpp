@@ -2,13 +2,14 @@
 // Displacement fields between two curves: the paper's basic algorithms and extensions.
 #include <morphomap/field.hpp>
 #include <morphomap/laplace.hpp>
+#include <morphomap/optimal.hpp>
 #include <morphomap/types.hpp>
 
 #include <optional>
 
 namespace morphomap {
 
-enum class MapMethod { minimal_distance, normal, diffusion, uniform, automatic };
+enum class MapMethod { minimal_distance, normal, diffusion, uniform, automatic, optimal };
 
 struct CurveMappingOptions {
   MapMethod method = MapMethod::automatic;  // the paper's Algorithm 1
@@ -31,6 +32,9 @@ struct CurveMappingOptions {
   // < 0: 1% of the finer of the two curves' median segment lengths; 0: exact contact only.
   double contact_tolerance = -1.0;
   DiffusionOptions diffusion;  // the mesh of diffusion mapping (also within "auto")
+  // "optimal": the weight of the stretch term against the squared displacements (see
+  // monotone_match in optimal.hpp); 0 gives the nearest order-preserving matching.
+  double stretch_weight = kDefaultStretchWeight;
 };
 
 // Both curves must be simple (no self-intersection, one loop) and, when closed, enclose an area:

@@ -12,6 +12,7 @@
 #include <morphomap/laplace.hpp>
 #include <morphomap/laplace3d.hpp>
 #include <morphomap/mapping.hpp>
+#include <morphomap/optimal.hpp>
 #include <morphomap/quality.hpp>
 #include <morphomap/remesh.hpp>
 #include <morphomap/resample.hpp>
