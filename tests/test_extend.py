@@ -25,19 +25,24 @@ def disc_mesh(c1, interior=300, seed=1):
     return points, Delaunay(points).simplices
 
 
+METHODS = [{"method": "harmonic"}, {"method": "elastic"}, {"method": "elastic", "poisson_ratio": 0.45}]
+
+
+@pytest.mark.parametrize("options", METHODS)
 @pytest.mark.parametrize("A, b", [(A2, B2), (1.7 * rotation(0.6), np.array([2.0, -1.0]))])
-def test_affine_boundary_maps_extend_to_the_same_map_in_2d(A, b):
+def test_affine_boundary_maps_extend_to_the_same_map_in_2d(A, b, options):
     c1 = circle(120)
     field = mm.DisplacementField(c1, c1 @ A.T + b, "normal", source=c1)
     for mesh in (None, disc_mesh(c1)):
-        interior = mm.extend_field(field, mesh=mesh)
+        interior = mm.extend_field(field, mesh=mesh, **options)
         expected = interior.points @ A.T + b - interior.points
         assert np.abs(interior.displacement - expected).max() < 1e-10
         assert interior.inverted == 0 and interior.boundary_distance < 1e-12
         assert interior.min_jacobian == pytest.approx(np.linalg.det(A), rel=1e-9)
 
 
-def test_affine_boundary_maps_extend_to_the_same_map_in_3d():
+@pytest.mark.parametrize("options", METHODS)
+def test_affine_boundary_maps_extend_to_the_same_map_in_3d(options):
     s1 = trimesh.creation.icosphere(2)
     rng = np.random.default_rng(2)
     inside = rng.normal(size=(400, 3))
@@ -45,7 +50,7 @@ def test_affine_boundary_maps_extend_to_the_same_map_in_3d():
     points = np.vstack([s1.vertices, inside])
     cells = Delaunay(points).simplices
     field = mm.DisplacementField(s1.vertices, s1.vertices @ A3.T + B3, "normal", faces=s1.faces)
-    interior = mm.extend_field(field, mesh=(points, cells))
+    interior = mm.extend_field(field, mesh=(points, cells), **options)
     assert np.abs(interior.displacement - (points @ A3.T + B3 - points)).max() < 1e-10
     assert interior.inverted == 0 and interior.boundary_distance < 1e-12
 
@@ -90,7 +95,14 @@ def test_bad_input_is_named():
     c1 = circle(40)
     field = mm.DisplacementField(c1, 2 * c1, "normal", source=c1)
     with pytest.raises(ValueError, match="method"):
-        mm.extend_field(field, method="elastic")
+        mm.extend_field(field, method="biharmonic")
+    for nu in (-0.1, 0.5, 0.7, np.nan):
+        with pytest.raises(ValueError, match="poisson_ratio: must be at least 0 and below 0.5"):
+            mm.extend_field(field, method="elastic", poisson_ratio=nu)
+    with pytest.raises(TypeError, match="poisson_ratio"):
+        mm.extend_field(field, method="elastic", poisson_ratio="0.3")
+    with pytest.raises(ValueError, match="substeps: must be at least 1"):
+        mm.extend_field(field, substeps=0)
     with pytest.raises(ValueError, match="mesh cells"):
         mm.extend_field(field, mesh=(c1, np.zeros((3, 4), int)))
     with pytest.raises(ValueError, match="mesh: cell 0 refers to point 99"):
@@ -108,3 +120,22 @@ def test_bad_input_is_named():
         mm.extend_field(field3)
     with pytest.raises(ValueError, match="boundary: this field does not know"):
         mm.extend_field(mm.DisplacementField(c1, 2 * c1, "normal"))
+
+
+@pytest.mark.parametrize("nu", [0.0, 0.3, 0.45])
+def test_elastic_extension_converges_to_a_solution_of_navier_equations(nu):
+    # u = (x^2 - (lambda + 2 mu) / mu y^2, 0) has mu lap u + (lambda + mu) grad div u = 0 and is not
+    # harmonic: the elastic extension of its boundary values tends to it, the harmonic one does not.
+    c = -(2 * nu / (1 - 2 * nu) + 2)  # -(lambda + 2 mu) / mu, as lambda / mu = 2 nu / (1 - 2 nu)
+
+    def exact(x):
+        return np.column_stack([x[:, 0] ** 2 + c * x[:, 1] ** 2, np.zeros(len(x))])
+
+    c1 = circle(400)
+    field = mm.DisplacementField(c1, c1 + exact(c1), "normal", source=c1)
+    elastic = mm.extend_field(field, method="elastic", poisson_ratio=nu, mesh_size=0.03)
+    harmonic = mm.extend_field(field, mesh=(elastic.points, elastic.cells))
+    scale = np.abs(exact(elastic.points)).max()
+    error = np.abs(elastic.displacement - exact(elastic.points)).max()
+    assert error < 5e-4 * scale
+    assert np.abs(harmonic.displacement - exact(elastic.points)).max() > 100 * error

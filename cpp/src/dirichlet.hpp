@@ -97,10 +97,12 @@ inline Eigen::MatrixXd solve_direct(Eigen::SparseMatrix<double> stiffness, const
 // set, the given values; at the others, the P1 solution of the Laplace equation. elements:
 // (E, K) vertex indices; local(e) returns element e's K x K stiffness matrix. With iterative,
 // conjugate gradients with an incomplete Cholesky preconditioner come first (less memory and
-// time for 3D meshes), the sparse LDL^T factorisation otherwise or as the fallback.
+// time for 3D meshes), to the relative residual `tolerance`, the sparse LDL^T factorisation
+// otherwise or as the fallback.
 template <class Elements, class Local>
 Eigen::MatrixXd solve_dirichlet_values(Index vertex_count, const Elements& elements, const std::vector<char>& fixed,
-                                       Eigen::MatrixXd values, Local local, bool iterative) {
+                                       Eigen::MatrixXd values, Local local, bool iterative,
+                                       double tolerance = 1e-10) {
   std::vector<Index> unknown(vertex_count, -1);
   Index free_count = 0;
   for (Index v = 0; v < vertex_count; ++v) {
@@ -134,7 +136,7 @@ Eigen::MatrixXd solve_dirichlet_values(Index vertex_count, const Elements& eleme
     Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
                              Eigen::IncompleteCholesky<double>>
         cg;
-    cg.setTolerance(1e-10);
+    cg.setTolerance(tolerance);
     cg.compute(stiffness);
     solved = cg.info() == Eigen::Success;
     // In rounds of iterations, each continuing from the last, so that an interrupt is seen.
