@@ -80,6 +80,32 @@ def test_concentric_spheres_give_the_radial_field_inside():
     assert interior.inverted == 0
 
 
+@pytest.mark.parametrize("options", METHODS[:2])
+def test_affine_boundary_maps_extend_to_the_same_map_on_the_default_3d_mesh(options):
+    s1 = trimesh.creation.icosphere(2)
+    field = mm.DisplacementField(s1.vertices, s1.vertices @ A3.T + B3, "normal", faces=s1.faces)
+    interior = mm.extend_field(field, **options)
+    points = interior.points
+    assert len(points) > len(s1.vertices) and interior.cells.shape[1] == 4
+    assert np.linalg.norm(points, axis=1).max() <= 1 + 1e-12  # S1 is inscribed in the unit sphere
+    assert np.abs(interior.displacement - (points @ A3.T + B3 - points)).max() < 1e-10
+    assert interior.inverted == 0 and interior.boundary_distance < 1e-12
+    again = mm.extend_field(field, **options)  # the mesher's random choices are fixed
+    assert np.array_equal(again.points, points) and np.array_equal(again.cells, interior.cells)
+
+
+def test_concentric_spheres_give_the_radial_field_on_the_default_3d_mesh():
+    # Diffusion between R1 = 1 and R2 = 1.5: u = (R2 / R1 - 1) x inside, to the boundary field's accuracy.
+    s1 = trimesh.creation.icosphere(2)
+    field = mm.map_surfaces(s1, s1.copy().apply_scale(1.5), "diffusion")
+    boundary_error = np.abs(field.vectors - 0.5 * field.starts).max()
+    interior = mm.extend_field(field, mesh_size=0.2)
+    volume = np.abs(np.linalg.det(interior.points[interior.cells[:, 1:]] - interior.points[interior.cells[:, :1]])).sum() / 6
+    assert 0.95 * s1.volume < volume <= s1.volume  # the tetrahedra fill S1 (their faces chords of it)
+    assert np.abs(interior.displacement - 0.5 * interior.points).max() <= boundary_error + 1e-9
+    assert interior.inverted == 0 and interior.min_jacobian > 1.5 ** 3 * 0.9
+
+
 def test_inversions_are_counted():
     # A boundary map that turns part of the disc inside out (a half turn of one side).
     c1 = circle(100)
@@ -116,8 +142,11 @@ def test_bad_input_is_named():
         mm.extend_field(missed)
     s1 = trimesh.creation.icosphere(1)
     field3 = mm.map_surfaces(s1, s1.copy().apply_scale(1.5), "normal")
-    with pytest.raises(ValueError, match="mesh: 3D needs the solver's tetrahedral mesh"):
-        mm.extend_field(field3)
+    open_surface = mm.DisplacementField(s1.vertices, 1.5 * s1.vertices, "normal", faces=s1.faces[1:])
+    with pytest.raises(ValueError, match="field: its triangles do not close a volume"):
+        mm.extend_field(open_surface)
+    with pytest.raises(ValueError, match="mesh_size"):
+        mm.extend_field(field3, mesh_size=-1.0)
     with pytest.raises(ValueError, match="boundary: this field does not know"):
         mm.extend_field(mm.DisplacementField(c1, 2 * c1, "normal"))
 

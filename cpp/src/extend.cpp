@@ -5,6 +5,7 @@
 #include "dirichlet.hpp"
 #include "region_mesh.hpp"
 #include "validation.hpp"
+#include "volume_mesh.hpp"
 
 #include <algorithm>
 #include <array>
@@ -218,6 +219,23 @@ void require_options(const ExtendOptions& options) {
   if (!std::isfinite(options.mesh_size)) detail::invalid("mesh_size", "must be finite");
 }
 
+// The mesh size for Mesh_3: the one asked for, else the start triangles' mean edge (checking that
+// every corner has a start point, as the surface to mesh).
+double default_size(const DisplacementField3& field, const ExtendOptions& options) {
+  if (field.faces.rows() == 0) detail::invalid("field", "has no triangles to mesh the region they enclose");
+  double total = 0.0;
+  for (Index f = 0; f < field.faces.rows(); ++f) {
+    for (int i = 0; i < 3; ++i) {
+      const Index a = field.faces(f, i);
+      if (a < 0 || a >= field.starts.rows() || !field.starts.row(a).allFinite()) {
+        detail::invalid("field", "triangle " + std::to_string(f) + " has a corner without a start point: pass mesh=");
+      }
+    }
+    for (int i = 0; i < 3; ++i) total += (field.starts.row(field.faces(f, i)) - field.starts.row(field.faces(f, (i + 1) % 3))).norm();
+  }
+  return options.mesh_size > 0.0 ? options.mesh_size : total / (3.0 * field.faces.rows());
+}
+
 }  // namespace
 
 InteriorField2 extend_field(const DisplacementField2& field, const Points2Ref& source, const Points2Ref& mesh_points,
@@ -246,11 +264,15 @@ InteriorField3 extend_field(const DisplacementField3& field, const Points3Ref& m
   require_options(options);
   InteriorField3 out;
   if (mesh_cells.rows() == 0) {
-    detail::invalid("mesh", "3D needs the solver's tetrahedral mesh of the domain");
+    const detail::VolumeMesh mesh = detail::mesh_volume(field.starts, field.faces, default_size(field, options),
+                                                        options.seed, "field");
+    out.points = mesh.vertices;
+    out.cells = mesh.tetrahedra;
+  } else {
+    require_mesh(mesh_points, mesh_cells);
+    out.points = mesh_points;
+    out.cells = mesh_cells;
   }
-  require_mesh(mesh_points, mesh_cells);
-  out.points = mesh_points;
-  out.cells = mesh_cells;
   const std::vector<char> fixed = boundary_nodes(out.cells, out.points.rows());
   take_boundary_values(out, fixed, [&](const Points3& at) { return displacement_at(field, at); });
   solve_motion<3>(out, fixed, options);

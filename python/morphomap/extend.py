@@ -92,9 +92,12 @@ def extend_field(field, boundary=None, *, method="harmonic", mesh=None, mesh_siz
         or face of one cell only) are projected onto the source boundary and take the field
         there (:meth:`DisplacementField.at`); ``boundary_distance`` says how far they were. 2D
         without a mesh: the domain is meshed with CGAL's constrained Delaunay mesher, every
-        point of C1 a node. 3D needs the mesh.
+        point of C1 a node. 3D without a mesh: the region S1 (the field's start triangles, a
+        closed surface) encloses is meshed with CGAL's Mesh_3, its surface nodes on S1's
+        triangles; the mesher's random choices are fixed, so the same field gives the same mesh.
     mesh_size : float, optional
-        2D without a mesh: the largest edge (default: graded from C1's point spacing).
+        Without a mesh, 2D: the largest edge (default: graded from C1's point spacing); 3D: the
+        edge length of the tetrahedra and surface triangles (default: S1's mean edge).
     poisson_ratio : float
         ``"elastic"`` only: 0 <= nu < 0.5 (near 0.5 the interior resists changes of volume).
     substeps : int
@@ -121,10 +124,10 @@ def extend_field(field, boundary=None, *, method="harmonic", mesh=None, mesh_siz
                              f"{cells.shape}")
         cells = np.ascontiguousarray(cells, dtype=np.int64)
     if field.dim == 3:
-        if mesh is None:
-            raise ValueError("mesh: 3D needs the solver's tetrahedral mesh of the domain, mesh=(points, cells)")
         if field.faces is None:
             raise ValueError("field: a 3D field needs its faces")
+        if mesh is None:
+            points, cells = np.zeros((0, 3)), np.zeros((0, 4), dtype=np.int64)
         result = _core.extend_field_3d(field.starts, field.ends, field.faces, points, cells,
                                        mesh_size=as_length(mesh_size, "mesh_size", 0.0), **options)
     else:

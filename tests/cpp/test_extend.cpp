@@ -72,6 +72,13 @@ void test_3d() {
     CHECK((out.displacement - expected).cwiseAbs().maxCoeff() < 1e-10);
     CHECK(out.inverted == 0 && out.boundary_distance < 1e-12);
   }
+  // No mesh given: Mesh_3 fills the cube, its surface nodes on the cube's faces.
+  options.mesh_size = 0.3;
+  const auto filled = extend_field(field, Points3(0, 3), Tetrahedra(0, 4), options);
+  CHECK(filled.points.rows() > 8);
+  const Points3 expected = filled.points * a.transpose() - filled.points;
+  CHECK((filled.displacement - expected).cwiseAbs().maxCoeff() < 1e-10);
+  CHECK(filled.inverted == 0 && filled.boundary_distance < 1e-12);
 }
 
 }  // namespace
