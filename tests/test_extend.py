@@ -106,6 +106,34 @@ def test_concentric_spheres_give_the_radial_field_on_the_default_3d_mesh():
     assert interior.inverted == 0 and interior.min_jacobian > 1.5 ** 3 * 0.9
 
 
+@pytest.mark.parametrize("options", METHODS[:2])
+def test_substeps_keep_affine_maps_exact(options):
+    # Each substep moves the boundary by an affine map of the moved mesh: exact again.
+    c1 = circle(120)
+    A = 1.7 * rotation(0.6)
+    field = mm.DisplacementField(c1, c1 @ A.T + B2, "normal", source=c1)
+    interior = mm.extend_field(field, substeps=5, **options)
+    assert np.abs(interior.displacement - (interior.points @ A.T + B2 - interior.points)).max() < 1e-10
+    s1 = trimesh.creation.icosphere(2)
+    field3 = mm.DisplacementField(s1.vertices, s1.vertices @ A3.T + B3, "normal", faces=s1.faces)
+    interior3 = mm.extend_field(field3, substeps=3, **options)
+    assert np.abs(interior3.displacement - (interior3.points @ A3.T + B3 - interior3.points)).max() < 1e-10
+
+
+def test_substeps_undo_the_inversions_of_the_kidney_bud():
+    # A bud grows out of a few microns of C1: one solve turns triangles over there, substeps do not.
+    field = mm.map_curves(*mm.load_example("kidney"), "diffusion")
+    once = mm.extend_field(field, mesh_size=0.02)
+    stepped = mm.extend_field(field, mesh=(once.points, once.cells), substeps=4)
+    assert once.inverted >= 1 and once.min_jacobian < 0
+    assert stepped.inverted == 0 and stepped.min_jacobian > 0.05
+    cells = once.cells
+    edges = np.sort(np.vstack([cells[:, [0, 1]], cells[:, [1, 2]], cells[:, [2, 0]]]), axis=1)
+    unique, counts = np.unique(edges, axis=0, return_counts=True)
+    boundary = np.unique(unique[counts == 1])  # the steps add up to the field there
+    assert np.abs(stepped.displacement[boundary] - field.at(once.points[boundary])).max() < 1e-12
+
+
 def test_inversions_are_counted():
     # A boundary map that turns part of the disc inside out (a half turn of one side).
     c1 = circle(100)

@@ -138,7 +138,7 @@ Eigen::MatrixXd extension_step(const Points& x, const Cells& cells, const std::v
       Eigen::Matrix<double, corners, D> g;
       const double measure = std::abs(simplex_gradients<D>(x, cells, c, g));
       return Eigen::Matrix<double, corners, corners>(measure * g * g.transpose());
-    }, iterative, tolerance);
+    }, iterative, tolerance, Eigen::MatrixXd(x));
   }
   // Linear elasticity with Young's modulus 1 (it cancels with Dirichlet data only): the unknowns
   // are the components, node * D + component, coupled through the strain.
@@ -151,11 +151,12 @@ Eigen::MatrixXd extension_step(const Points& x, const Cells& cells, const std::v
     }
   }
   std::vector<char> dof_fixed(x.rows() * D);
-  Eigen::MatrixXd flat(x.rows() * D, 1);
+  Eigen::MatrixXd flat(x.rows() * D, 1), positions(x.rows() * D, D);
   for (Index v = 0; v < x.rows(); ++v) {
     for (int a = 0; a < D; ++a) {
       dof_fixed[v * D + a] = fixed[v];
       flat(v * D + a, 0) = values(v, a);
+      positions.row(v * D + a) = x.row(v);
     }
   }
   flat = detail::solve_dirichlet_values(x.rows() * D, dofs, dof_fixed, std::move(flat), [&](Index c) {
@@ -175,7 +176,7 @@ Eigen::MatrixXd extension_step(const Points& x, const Cells& cells, const std::v
       }
     }
     return k;
-  }, iterative, tolerance);
+  }, iterative, tolerance, positions);
   for (Index v = 0; v < x.rows(); ++v) {
     for (int a = 0; a < D; ++a) values(v, a) = flat(v * D + a, 0);
   }
