@@ -164,7 +164,9 @@ Eigen::MatrixXd solve_dirichlet_values(Index vertex_count, const Elements& eleme
       if (unknown[v] >= 0) free_positions.row(unknown[v]) = positions.row(v);
     }
     const auto order = nested_dissection(stiffness, free_positions);
-    Eigen::SparseMatrix<double> ordered = order * stiffness * order.transpose();
+    // The lower triangle is all the factorisation reads.
+    Eigen::SparseMatrix<double> ordered(free_count, free_count);
+    ordered.selfadjointView<Eigen::Lower>() = stiffness.selfadjointView<Eigen::Lower>().twistedBy(order);
     x = order.transpose() * solve_direct<Eigen::NaturalOrdering<int>>(std::move(ordered), order * rhs);
   } else if (!solved) {
     x = solve_direct(std::move(stiffness), rhs);
