@@ -94,6 +94,24 @@ def test_affine_boundary_maps_extend_to_the_same_map_on_the_default_3d_mesh(opti
     assert np.array_equal(again.points, points) and np.array_equal(again.cells, interior.cells)
 
 
+def test_every_tetrahedron_of_the_default_3d_mesh_has_a_free_node():
+    # Tetrahedra with four corners on S1 would move with the boundary field alone: their longest
+    # chord is split. The lung-like S1 (tubes, a crotch) has many such caps under Mesh_3.
+    from morphomap.data.make_lung import lung_pair
+
+    s1, _ = lung_pair()
+    field = mm.DisplacementField(s1.vertices, s1.vertices @ A3.T + B3, "normal", faces=s1.faces)
+    interior = mm.extend_field(field)
+    cells = interior.cells
+    faces = np.sort(np.vstack([np.delete(cells, k, axis=1) for k in range(4)]), axis=1)
+    unique, counts = np.unique(faces, axis=0, return_counts=True)
+    on_surface = np.zeros(len(interior.points), bool)
+    on_surface[unique[counts == 1].ravel()] = True
+    assert not on_surface[cells].all(axis=1).any()
+    assert np.abs(interior.displacement - (interior.points @ A3.T + B3 - interior.points)).max() < 1e-10
+    assert interior.inverted == 0 and interior.boundary_distance < 1e-12
+
+
 def test_concentric_spheres_give_the_radial_field_on_the_default_3d_mesh():
     # Diffusion between R1 = 1 and R2 = 1.5: u = (R2 / R1 - 1) x inside, to the boundary field's accuracy.
     s1 = trimesh.creation.icosphere(2)

@@ -18,8 +18,14 @@
 #include <CGAL/boost/graph/helpers.h>
 #include <CGAL/make_mesh_3.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
+#include <set>
 #include <string>
+#include <utility>
+#include <vector>
 #include <unordered_map>
 
 namespace morphomap::detail {
@@ -55,6 +61,86 @@ ShellMesh as_shell_mesh(const C3t3& c3t3) {
   return mesh;
 }
 
+// Mesh_3 leaves tetrahedra with all four corners on the surface (caps under curved patches):
+// the boundary displacement alone moves them, and where the surface bends they turn over
+// whatever the interior does. Each gets a free node: the midpoint of its longest chord (an edge
+// between surface nodes on no surface triangle), splitting every tetrahedron round that edge.
+void split_chords(VolumeMesh& mesh) {
+  const Index n = mesh.vertices.rows();
+  std::vector<char> on_surface(n, 0);
+  std::set<std::pair<Index, Index>> surface_edges;
+  {
+    std::map<std::array<Index, 3>, int> faces;
+    for (Index t = 0; t < mesh.tetrahedra.rows(); ++t) {
+      for (int skip = 0; skip < 4; ++skip) {
+        std::array<Index, 3> face;
+        for (int i = 0, k = 0; i < 4; ++i) {
+          if (i != skip) face[k++] = mesh.tetrahedra(t, i);
+        }
+        std::sort(face.begin(), face.end());
+        ++faces[face];
+      }
+    }
+    for (const auto& [face, count] : faces) {
+      if (count != 1) continue;
+      for (int i = 0; i < 3; ++i) {
+        on_surface[face[i]] = 1;
+        surface_edges.emplace(face[i], face[(i + 1) % 3]);
+        surface_edges.emplace(face[(i + 1) % 3], face[i]);
+      }
+    }
+  }
+  std::set<std::pair<Index, Index>> chords;
+  for (Index t = 0; t < mesh.tetrahedra.rows(); ++t) {
+    bool all = true;
+    for (int i = 0; i < 4; ++i) all = all && on_surface[mesh.tetrahedra(t, i)];
+    if (!all) continue;
+    std::pair<Index, Index> longest(-1, -1);
+    double length = -1.0;
+    for (int i = 0; i < 4; ++i) {
+      for (int j = i + 1; j < 4; ++j) {
+        const Index a = std::min(mesh.tetrahedra(t, i), mesh.tetrahedra(t, j));
+        const Index b = std::max(mesh.tetrahedra(t, i), mesh.tetrahedra(t, j));
+        const double l = (mesh.vertices.row(a) - mesh.vertices.row(b)).norm();
+        if (!surface_edges.count({a, b}) && l > length) {
+          length = l;
+          longest = {a, b};
+        }
+      }
+    }
+    if (longest.first >= 0) chords.insert(longest);
+  }
+  if (chords.empty()) return;
+  // Each tetrahedron with both ends of a chord becomes two, the midpoint in place of one end and
+  // then the other (the orientation stays); a chord another split has cut is left.
+  std::vector<Eigen::Matrix<Index, 1, 4>> tets;
+  for (Index t = 0; t < mesh.tetrahedra.rows(); ++t) tets.push_back(mesh.tetrahedra.row(t));
+  std::vector<Eigen::RowVector3d> added;
+  for (const auto& [a, b] : chords) {
+    const Index m = n + static_cast<Index>(added.size());
+    bool split = false;
+    const std::size_t count = tets.size();
+    for (std::size_t t = 0; t < count; ++t) {
+      int ia = -1, ib = -1;
+      for (int i = 0; i < 4; ++i) {
+        if (tets[t](i) == a) ia = i;
+        if (tets[t](i) == b) ib = i;
+      }
+      if (ia < 0 || ib < 0) continue;
+      Eigen::Matrix<Index, 1, 4> other = tets[t];
+      tets[t](ib) = m;
+      other(ia) = m;
+      tets.push_back(other);
+      split = true;
+    }
+    if (split) added.push_back(0.5 * (mesh.vertices.row(a) + mesh.vertices.row(b)));
+  }
+  mesh.vertices.conservativeResize(n + static_cast<Index>(added.size()), 3);
+  for (std::size_t k = 0; k < added.size(); ++k) mesh.vertices.row(n + static_cast<Index>(k)) = added[k];
+  mesh.tetrahedra.resize(static_cast<Index>(tets.size()), 4);
+  for (std::size_t t = 0; t < tets.size(); ++t) mesh.tetrahedra.row(static_cast<Index>(t)) = tets[t];
+}
+
 }  // namespace
 
 VolumeMesh mesh_volume(const Points3Ref& vertices, const FacesRef& faces, double size, int seed, const char* name) {
@@ -85,7 +171,9 @@ VolumeMesh mesh_volume(const Points3Ref& vertices, const FacesRef& faces, double
         }
       },
       "meshing the region the surface encloses");
-  return {shell.vertices, shell.tetrahedra};
+  VolumeMesh mesh{shell.vertices, shell.tetrahedra};
+  split_chords(mesh);
+  return mesh;
 }
 
 }  // namespace morphomap::detail
