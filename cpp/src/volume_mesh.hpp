@@ -12,7 +12,8 @@ struct VolumeMesh {
 
 // The surface: closed, manifold, free of self-intersections (else InvalidInput naming
 // `name`). Edges and surface triangles about `size` long; `seed` fixes Mesh_3's random choices
-// (the same seed, the same mesh). Runs in a child process (mesh_in_child.hpp): a crash of CGAL
+// (the same seed, the same mesh). Every tetrahedron has a corner off the surface (a tetrahedron
+// with four corners on it has its longest chord split at the midpoint). Runs in a child process (mesh_in_child.hpp): a crash of CGAL
 // becomes a GeometryError. Throws GeometryError if Mesh_3 gives no tetrahedra.
 VolumeMesh mesh_volume(const Points3Ref& vertices, const FacesRef& faces, double size, int seed, const char* name);
 
