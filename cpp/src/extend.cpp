@@ -232,7 +232,9 @@ double default_size(const DisplacementField3& field, const ExtendOptions& option
         detail::invalid("field", "triangle " + std::to_string(f) + " has a corner without a start point: pass mesh=");
       }
     }
-    for (int i = 0; i < 3; ++i) total += (field.starts.row(field.faces(f, i)) - field.starts.row(field.faces(f, (i + 1) % 3))).norm();
+    for (int i = 0; i < 3; ++i) {
+      total += (field.starts.row(field.faces(f, i)) - field.starts.row(field.faces(f, (i + 1) % 3))).norm();
+    }
   }
   return options.mesh_size > 0.0 ? options.mesh_size : total / (3.0 * field.faces.rows());
 }

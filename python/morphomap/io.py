@@ -127,8 +127,8 @@ def write_curve(path, points, *, header=True) -> None:
 
 def write_field(path, field: DisplacementField, *, dt=None) -> None:
     """Write a displacement field; the format from the suffix: ``.csv`` (below), ``.vtu``, ``.vtp``
-    (needs the optional ``vtk`` package), ``.xdmf`` or a COMSOL ``.txt`` table (:mod:`morphomap.solver_files`; ``dt`` adds the velocity
-    there).
+    (needs the optional ``vtk`` package), ``.xdmf`` or a COMSOL ``.txt`` table
+    (:mod:`morphomap.solver_files`; ``dt`` adds the velocity there).
 
     CSV: ``start_x,start_y,end_x,end_y,valid,method`` per vector.
 

@@ -3,9 +3,10 @@
 By suffix: ``.vtu`` (VTK unstructured grid: ParaView), ``.vtp`` (VTK PolyData, boundary fields
 only: their triangles or points), ``.xdmf`` (+ ``.h5`` beside it: FEniCSx, ParaView), ``.txt`` (a
 COMSOL interpolation table, spreadsheet format). meshio writes ``.vtu`` and XDMF; ``.vtp`` needs
-the optional ``vtk`` package (``pip install morphomap[vtk]``; meshio has no PolyData writer). Point data: ``displacement`` (and ``velocity`` when a time step is given), for boundary
-fields also ``end``, ``valid`` (1/0) and ``method`` (an index into
-:data:`morphomap.field.METHOD_NAMES`, written into the file's comments or field data). 2D vectors
+the optional ``vtk`` package (``pip install morphomap[vtk]``; meshio has no PolyData writer).
+Point data: ``displacement`` (and ``velocity`` when a time step is given), for boundary fields
+also ``end``, ``valid`` (1/0) and ``method`` (an index into :data:`morphomap.field.METHOD_NAMES`,
+written into the file's comments or field data). 2D vectors
 get a zero third component in VTK files (ParaView's vectors are 3D) and stay 2D in XDMF (FEniCSx
 meshes of the plane).
 
