@@ -1,18 +1,27 @@
 #!/usr/bin/env python3
 """extend_field against scikit-fem solving the same vector Laplace problem on the same mesh.
 
-    PYTHONPATH=build/dev/pkg python3 bench/bench_extend.py
+    PYTHONPATH=build/dev/pkg python3 bench/bench_extend.py [speed|speed3d|inversions]
 
-The bundled kidney pair, diffusion mapping, then the harmonic extension on CGAL meshes of
+speed: the bundled kidney pair, diffusion mapping, then the harmonic extension on CGAL meshes of
 Omega_1 at three sizes. morphomap: ``extend_field(field, mesh=(points, cells))`` (boundary nodes,
 field.at, P1 assembly, one LDL^T for both components, inversion count). Peer: scikit-fem
 assembling the P1 Laplacian on the same mesh and solving the Dirichlet problem for both
 components with scipy's spsolve (SuperLU), the boundary values taken from morphomap's answer so
 that both solve the same problem; the answers are compared. Best of 3, one process.
+
+speed3d: the lung-like pair (morphomap.data.make_lung), auto mapping, the harmonic extension on
+morphomap's Mesh_3 meshes of S1's inside at three sizes; the peer: scikit-fem on the same
+tetrahedra, each component solved with pyamg (smoothed aggregation, CG, relative residual 1e-10)
+and with spsolve.
+
+inversions: cells turned over by the motion, for one solve and for substeps, harmonic and
+elastic, on the kidney pair (diffusion and normal fields) and the lung-like pair.
 """
 
 from __future__ import annotations
 
+import sys
 import time
 
 import numpy as np
@@ -29,25 +38,40 @@ def best(function, repeat=3):
     return min(times), result
 
 
-def peer(points, cells, fixed, values):
+def peer(points, cells, fixed, values, solver="spsolve"):
     import scipy.sparse.linalg as sparse
-    from skfem import Basis, ElementTriP1, MeshTri, condense
+    from skfem import Basis, ElementTetP1, ElementTriP1, MeshTet, MeshTri, condense
     from skfem.models.poisson import laplace
 
-    mesh = MeshTri(np.ascontiguousarray(points.T), np.ascontiguousarray(cells.T), sort_t=False)
-    basis = Basis(mesh, ElementTriP1())
+    dim = points.shape[1]
+    kind, element = (MeshTri, ElementTriP1) if dim == 2 else (MeshTet, ElementTetP1)
+    mesh = kind(np.ascontiguousarray(points.T), np.ascontiguousarray(cells.T), sort_t=False)
+    basis = Basis(mesh, element())
     K = laplace.assemble(basis)
     out = np.zeros_like(values)
-    for k in range(2):
+    for k in range(dim):
         x = np.zeros(len(points))
         x[fixed] = values[fixed, k]
         A, b, x_full, interior = condense(K, x=x, D=fixed)
-        x_full[interior] = sparse.spsolve(A, b)
+        if solver == "pyamg":
+            import pyamg
+
+            x_full[interior] = pyamg.smoothed_aggregation_solver(A.tocsr()).solve(b, tol=1e-10, accel="cg")
+        else:
+            x_full[interior] = sparse.spsolve(A, b)
         out[:, k] = x_full
     return out
 
 
-def main():
+def boundary_nodes(cells):
+    """Nodes on a side (edge, triangle) of one cell only."""
+    corners = cells.shape[1]
+    sides = np.sort(np.vstack([np.delete(cells, skip, axis=1) for skip in range(corners)]), axis=1)
+    unique, counts = np.unique(sides, axis=0, return_counts=True)
+    return np.unique(unique[counts == 1])
+
+
+def speed():
     c1, c2 = mm.load_example("kidney")
     field = mm.map_curves(c1, c2, "diffusion")
     print("| nodes | triangles | morphomap s | scikit-fem s | scikit-fem / morphomap | max difference |")
@@ -56,13 +80,65 @@ def main():
         mesh = mm.extend_field(field, mesh_size=size)
         points, cells = np.array(mesh.points), np.array(mesh.cells)
         ours_s, ours = best(lambda: mm.extend_field(field, mesh=(points, cells)))
-        edges = np.sort(np.vstack([cells[:, [0, 1]], cells[:, [1, 2]], cells[:, [2, 0]]]), axis=1)
-        unique, counts = np.unique(edges, axis=0, return_counts=True)
-        fixed = np.unique(unique[counts == 1])
+        fixed = boundary_nodes(cells)
         peer_s, theirs = best(lambda: peer(points, cells, fixed, ours.displacement))
         difference = np.abs(theirs - ours.displacement).max()
         print(f"| {len(points)} | {len(cells)} | {ours_s:.3f} | {peer_s:.3f} | {peer_s / ours_s:.2f} | {difference:.1e} |")
 
 
+def speed3d():
+    from morphomap.data.make_lung import lung_pair
+
+    field = mm.map_surfaces(*lung_pair(), "auto")
+    print("| nodes | tetrahedra | mesh s | morphomap s | pyamg s | ratio | spsolve s | ratio | max difference |")
+    print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    for size in (None, 0.05, 0.03):
+        mesh_s, mesh = best(lambda: mm.extend_field(field, mesh_size=size), repeat=1)
+        points, cells = np.array(mesh.points), np.array(mesh.cells)
+        ours_s, ours = best(lambda: mm.extend_field(field, mesh=(points, cells)))
+        fixed = boundary_nodes(cells)
+        amg_s, amg = best(lambda: peer(points, cells, fixed, ours.displacement, "pyamg"))
+        lu_s, lu = best(lambda: peer(points, cells, fixed, ours.displacement))
+        difference = max(np.abs(amg - ours.displacement).max(), np.abs(lu - ours.displacement).max())
+        print(f"| {len(points)} | {len(cells)} | {mesh_s:.2f} | {ours_s:.3f} | {amg_s:.3f} | {amg_s / ours_s:.2f} | "
+              f"{lu_s:.3f} | {lu_s / ours_s:.2f} | {difference:.1e} |")
+
+
+def inversion_row(label, field, mesh, variants):
+    cells = [label, str(len(mesh[1]))]
+    for options in variants:
+        if options is None:
+            cells.append("")
+            continue
+        start = time.perf_counter()
+        out = mm.extend_field(field, mesh=mesh, **options)
+        cells.append(f"{out.inverted} ({out.min_jacobian:.3g}, {time.perf_counter() - start:.1f} s)")
+    print("| " + " | ".join(cells) + " |", flush=True)
+
+
+def inversions():
+    from morphomap.data.make_lung import lung_pair
+
+    variants = [{}, {"substeps": 4}, {"substeps": 16}, {"method": "elastic"}, {"method": "elastic", "substeps": 16}]
+    print("| pair, field, mesh size | cells | harmonic | 4 substeps | 16 substeps | elastic | elastic, 16 substeps |")
+    print("|---|---:|---:|---:|---:|---:|---:|")
+    c1, c2 = mm.load_example("kidney")
+    for method in ("diffusion", "normal"):
+        field = mm.map_curves(c1, c2, method)
+        for size in (0.05, 0.02, 0.005):
+            mesh = mm.extend_field(field, mesh_size=size)
+            slow = size < 0.01  # elastic substeps take minutes there
+            inversion_row(f"kidney, {method}, {size}", field, (mesh.points, mesh.cells),
+                          variants[:-1] + [None] if slow else variants)
+    s1, s2 = lung_pair()
+    for method in ("auto", "diffusion"):
+        field = mm.map_surfaces(s1, s2, method)
+        for size in (None, 0.05):
+            mesh = mm.extend_field(field, mesh_size=size)
+            inversion_row(f"lung, {method}, {size or 'default'}", field, (mesh.points, mesh.cells), variants)
+
+
 if __name__ == "__main__":
-    main()
+    tables = {"speed": speed, "speed3d": speed3d, "inversions": inversions}
+    for name in sys.argv[1:] or list(tables):
+        tables[name]()

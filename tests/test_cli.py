@@ -138,6 +138,12 @@ def test_extend_writes_the_interior_displacement(tmp_path):
     assert done.returncode == 0, done.stderr
     table = np.loadtxt(tmp_path / "u.txt", comments="%")
     assert np.allclose(table[:, :2], solver.points) and np.allclose(table[:, 2:], solver.displacement)
+    done = subprocess.run([*command, "--method", "diffusion", "--mesh", str(tmp_path / "solver.xdmf"), "--extension",
+                           "elastic", "--substeps", "2", "-o", str(tmp_path / "e.txt")], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    elastic = mm.extend_field(mm.map_curves(c1, c2, "diffusion"), mesh=(solver.points, solver.cells),
+                              method="elastic", substeps=2)
+    assert np.allclose(np.loadtxt(tmp_path / "e.txt", comments="%")[:, 2:], elastic.displacement)
     done = subprocess.run([*command, "--mesh", str(tmp_path / "u.txt"), "-o", str(tmp_path / "v.vtu")],
                           capture_output=True, text=True)
     assert done.returncode == 2 and "cannot read the mesh" in done.stderr

@@ -172,3 +172,52 @@ def test_paraview_reads_the_arrays(tmp_path):
     assert np.allclose(np.array(got["u.vtu"]["velocity"])[:, :2], interior.displacement / 2.0)
     assert np.allclose(np.array(got["f.vtu"]["displacement"])[:, :2], field.vectors)
     assert got["f.vtu"]["valid"] == [1] * len(field)
+
+
+def test_vtp_boundary_fields_open_in_vtk_and_paraview(tmp_path):
+    import importlib.util
+
+    require_client(importlib.util.find_spec("vtk") is not None, "VTK (pip install vtk, the .vtp writer)")
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
+
+    field, _ = affine_interior()
+    s1 = trimesh.creation.icosphere(2)
+    field3 = mm.map_surfaces(s1, s1.copy().apply_scale(1.5), "normal")
+    mm.write_field(tmp_path / "f.vtp", field, dt=0.5)
+    mm.write_field(tmp_path / "f3.vtp", field3)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["f.vtp", "f3.vtp"]  # nothing left behind
+    reader = vtkXMLPolyDataReader()
+    reader.SetFileName(str(tmp_path / "f3.vtp"))
+    reader.Update()
+    poly = reader.GetOutput()
+    assert np.allclose(vtk_to_numpy(poly.GetPoints().GetData()), field3.starts)
+    assert np.array_equal(vtk_to_numpy(poly.GetPolys().GetConnectivityArray()).reshape(-1, 3), field3.faces)
+    assert np.allclose(vtk_to_numpy(poly.GetPointData().GetArray("displacement")), field3.vectors)
+    with pytest.raises(ValueError, match="path: unknown format '.vtp'"):
+        mm.write_interior(tmp_path / "u.vtp", mm.extend_field(field, mesh_size=0.3))
+
+    require_client(shutil.which("pvpython") is not None, "ParaView (pvpython, python3-paraview)")
+    got = run_client(["pvpython"], """
+        import json
+        from paraview import servermanager
+        from paraview.simple import OpenDataFile
+        from vtk.util.numpy_support import vtk_to_numpy
+
+        out = {}
+        for name in ("f.vtp", "f3.vtp"):
+            source = OpenDataFile(name)
+            source.UpdatePipeline()
+            data = servermanager.Fetch(source)
+            arrays = data.GetPointData()
+            out[name] = {"points": vtk_to_numpy(data.GetPoints().GetData()).tolist(), "cells": data.GetNumberOfCells(),
+                         **{arrays.GetArrayName(k): vtk_to_numpy(arrays.GetArray(k)).tolist()
+                            for k in range(arrays.GetNumberOfArrays())}}
+        print(json.dumps(out))
+    """, tmp_path)
+    assert got["f.vtp"]["cells"] == len(field) and got["f3.vtp"]["cells"] == len(field3.faces)
+    assert np.allclose(np.array(got["f.vtp"]["points"])[:, :2], field.starts)
+    assert np.allclose(np.array(got["f.vtp"]["displacement"])[:, :2], field.vectors)
+    assert np.allclose(np.array(got["f.vtp"]["velocity"])[:, :2], field.vectors / 0.5)
+    assert got["f.vtp"]["valid"] == [1] * len(field)
+    assert np.allclose(np.array(got["f3.vtp"]["displacement"]), field3.vectors)

@@ -6,9 +6,11 @@
 #include <morphomap/types.hpp>
 
 #include "interrupt_check.hpp"
+#include "nested_dissection.hpp"
 
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/LU>
+#include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
@@ -57,7 +59,9 @@ double tetrahedron_gradients(const Vertices& vertices, const Tets& tets, Index t
 // The sparse LDL^T solve (one factorisation, every column of rhs), on a thread of its own so
 // that an interrupt is seen while it runs (a factorisation cannot stop half way): on an interrupt
 // the caller returns at once and the thread finishes on its own, its matrices freed with it.
-inline Eigen::MatrixXd solve_direct(Eigen::SparseMatrix<double> stiffness, const Eigen::MatrixXd& rhs) {
+// Ordering: Eigen's fill-reducing order (NaturalOrdering when the caller has ordered the rows).
+template <class Ordering = Eigen::AMDOrdering<int>>
+Eigen::MatrixXd solve_direct(Eigen::SparseMatrix<double> stiffness, const Eigen::MatrixXd& rhs) {
   struct Work {
     Eigen::SparseMatrix<double> matrix;
     Eigen::MatrixXd rhs, x;
@@ -70,7 +74,7 @@ inline Eigen::MatrixXd solve_direct(Eigen::SparseMatrix<double> stiffness, const
   work->rhs = rhs;
   std::thread worker([work] {
     try {
-      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> direct(work->matrix);
+      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Ordering> direct(work->matrix);
       if (direct.info() != Eigen::Success) work->singular = true;
       else work->x = direct.solve(work->rhs);
     } catch (...) {
@@ -97,10 +101,13 @@ inline Eigen::MatrixXd solve_direct(Eigen::SparseMatrix<double> stiffness, const
 // set, the given values; at the others, the P1 solution of the Laplace equation. elements:
 // (E, K) vertex indices; local(e) returns element e's K x K stiffness matrix. With iterative,
 // conjugate gradients with an incomplete Cholesky preconditioner come first (less memory and
-// time for 3D meshes), the sparse LDL^T factorisation otherwise or as the fallback.
+// time for 3D meshes), to the relative residual `tolerance`, the sparse LDL^T factorisation
+// otherwise or as the fallback. With `positions` (a row per vertex), the factorisation takes the
+// unknowns in a nested-dissection order of them (nested_dissection.hpp) rather than Eigen's AMD.
 template <class Elements, class Local>
 Eigen::MatrixXd solve_dirichlet_values(Index vertex_count, const Elements& elements, const std::vector<char>& fixed,
-                                       Eigen::MatrixXd values, Local local, bool iterative) {
+                                       Eigen::MatrixXd values, Local local, bool iterative,
+                                       double tolerance = 1e-10, const Eigen::MatrixXd& positions = {}) {
   std::vector<Index> unknown(vertex_count, -1);
   Index free_count = 0;
   for (Index v = 0; v < vertex_count; ++v) {
@@ -134,7 +141,7 @@ Eigen::MatrixXd solve_dirichlet_values(Index vertex_count, const Elements& eleme
     Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
                              Eigen::IncompleteCholesky<double>>
         cg;
-    cg.setTolerance(1e-10);
+    cg.setTolerance(tolerance);
     cg.compute(stiffness);
     solved = cg.info() == Eigen::Success;
     // In rounds of iterations, each continuing from the last, so that an interrupt is seen.
@@ -151,7 +158,19 @@ Eigen::MatrixXd solve_dirichlet_values(Index vertex_count, const Elements& eleme
       x.col(column) = xc;
     }
   }
-  if (!solved) x = solve_direct(std::move(stiffness), rhs);
+  if (!solved && positions.rows() == vertex_count) {
+    Eigen::MatrixXd free_positions(free_count, positions.cols());
+    for (Index v = 0; v < vertex_count; ++v) {
+      if (unknown[v] >= 0) free_positions.row(unknown[v]) = positions.row(v);
+    }
+    const auto order = nested_dissection(stiffness, free_positions);
+    // The lower triangle is all the factorisation reads.
+    Eigen::SparseMatrix<double> ordered(free_count, free_count);
+    ordered.selfadjointView<Eigen::Lower>() = stiffness.selfadjointView<Eigen::Lower>().twistedBy(order);
+    x = order.transpose() * solve_direct<Eigen::NaturalOrdering<int>>(std::move(ordered), order * rhs);
+  } else if (!solved) {
+    x = solve_direct(std::move(stiffness), rhs);
+  }
   for (Index v = 0; v < vertex_count; ++v) {
     if (unknown[v] >= 0) values.row(v) = x.row(unknown[v]);
   }

@@ -5,6 +5,7 @@
 #include "dirichlet.hpp"
 #include "region_mesh.hpp"
 #include "validation.hpp"
+#include "volume_mesh.hpp"
 
 #include <algorithm>
 #include <array>
@@ -111,30 +112,143 @@ void take_boundary_values(Interior& out, const std::vector<char>& fixed, const P
   out.boundary_distance = boundary.distances.size() ? boundary.distances.maxCoeff() : 0.0;
 }
 
-template <class Interior, class Local>
-void solve_harmonic(Interior& out, const std::vector<char>& fixed, const Local& local, bool iterative) {
+// Gradients of the barycentric coordinates of a cell (rows) and its signed area (volume).
+template <int D, class Points, class Cells>
+double simplex_gradients(const Points& x, const Cells& cells, Index c, Eigen::Matrix<double, D + 1, D>& g) {
+  Eigen::Matrix<double, D, D> edges;
+  for (int i = 0; i < D; ++i) edges.col(i) = (x.row(cells(c, i + 1)) - x.row(cells(c, 0))).transpose();
+  const Eigen::Matrix<double, D, D> inverse = edges.inverse();
+  g.template bottomRows<D>() = inverse;
+  g.row(0) = -inverse.colwise().sum();
+  return edges.determinant() / (D == 2 ? 2.0 : 6.0);
+}
+
+// One solve on the mesh at positions x: `values` holds the displacement at the fixed nodes; the
+// others get the method's solution. P1 elements; in 3D conjugate gradients first (less memory).
+template <int D, class Points, class Cells>
+Eigen::MatrixXd extension_step(const Points& x, const Cells& cells, const std::vector<char>& fixed,
+                               Eigen::MatrixXd values, const ExtendOptions& options) {
+  constexpr int corners = D + 1;
+  const bool iterative = D == 3;
+  // An affine boundary map must come back to rounding, not to the diffusion solver's 1e-10.
+  constexpr double tolerance = 1e-12;
+  if (options.method == ExtensionMethod::harmonic) {
+    // One scalar Laplacian; each component a column of the right-hand side.
+    return detail::solve_dirichlet_values(x.rows(), cells, fixed, std::move(values), [&](Index c) {
+      Eigen::Matrix<double, corners, D> g;
+      const double measure = std::abs(simplex_gradients<D>(x, cells, c, g));
+      return Eigen::Matrix<double, corners, corners>(measure * g * g.transpose());
+    }, iterative, tolerance, Eigen::MatrixXd(x));
+  }
+  // Linear elasticity with Young's modulus 1 (it cancels with Dirichlet data only): the unknowns
+  // are the components, node * D + component, coupled through the strain.
+  const double nu = options.poisson_ratio;
+  const double mu = 0.5 / (1.0 + nu), lambda = nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
+  Eigen::Matrix<Index, Eigen::Dynamic, corners * D, Eigen::RowMajor> dofs(cells.rows(), corners * D);
+  for (Index c = 0; c < cells.rows(); ++c) {
+    for (int i = 0; i < corners; ++i) {
+      for (int a = 0; a < D; ++a) dofs(c, i * D + a) = cells(c, i) * D + a;
+    }
+  }
+  std::vector<char> dof_fixed(x.rows() * D);
+  Eigen::MatrixXd flat(x.rows() * D, 1), positions(x.rows() * D, D);
+  for (Index v = 0; v < x.rows(); ++v) {
+    for (int a = 0; a < D; ++a) {
+      dof_fixed[v * D + a] = fixed[v];
+      flat(v * D + a, 0) = values(v, a);
+      positions.row(v * D + a) = x.row(v);
+    }
+  }
+  flat = detail::solve_dirichlet_values(x.rows() * D, dofs, dof_fixed, std::move(flat), [&](Index c) {
+    Eigen::Matrix<double, corners, D> g;
+    const double measure = std::abs(simplex_gradients<D>(x, cells, c, g));
+    // The bilinear form 2 mu eps(u):eps(v) + lambda div u div v for u = phi_j e_b, v = phi_i e_a.
+    Eigen::Matrix<double, corners * D, corners * D> k;
+    for (int i = 0; i < corners; ++i) {
+      for (int j = 0; j < corners; ++j) {
+        const double dot = g.row(i).dot(g.row(j));
+        for (int a = 0; a < D; ++a) {
+          for (int b = 0; b < D; ++b) {
+            k(i * D + a, j * D + b) =
+                measure * (mu * (a == b ? dot : 0.0) + mu * g(i, b) * g(j, a) + lambda * g(i, a) * g(j, b));
+          }
+        }
+      }
+    }
+    return k;
+  }, iterative, tolerance, positions);
+  for (Index v = 0; v < x.rows(); ++v) {
+    for (int a = 0; a < D; ++a) values(v, a) = flat(v * D + a, 0);
+  }
+  return values;
+}
+
+// The motion of the interior: out.displacement holds the boundary displacement at the fixed
+// nodes on entry, the displacement of every node on return. In substeps, each moving the
+// boundary by an equal share of what remains and solving on the mesh as moved so far.
+template <int D, class Interior>
+void solve_motion(Interior& out, const std::vector<char>& fixed, const ExtendOptions& options) {
   // A flat cell has no gradients: its stiffness would be infinite.
   for (Index c = 0; c < out.cells.rows(); ++c) {
     if (!(std::abs(signed_measure(out.points, out.cells, c)) > 0)) {
-      detail::invalid("mesh", "cell " + std::to_string(c) + " is flat (zero " +
-                                  (out.cells.cols() == 3 ? "area" : "volume") + ")");
+      detail::invalid("mesh", "cell " + std::to_string(c) + " is flat (zero " + (D == 2 ? "area" : "volume") + ")");
     }
   }
-  out.displacement = detail::solve_dirichlet_values(out.points.rows(), out.cells, fixed,
-                                                    Eigen::MatrixXd(out.displacement), local, iterative);
-  if (!out.displacement.allFinite()) throw GeometryError("the harmonic extension has no finite solution on this mesh");
+  const Eigen::MatrixXd boundary = out.displacement;
+  Eigen::MatrixXd total = Eigen::MatrixXd::Zero(out.points.rows(), D);
+  auto moved = out.points;
+  for (int step = 0; step < options.substeps; ++step) {
+    const Eigen::MatrixXd share = (boundary - total) / static_cast<double>(options.substeps - step);
+    const Eigen::MatrixXd increment = extension_step<D>(moved, out.cells, fixed, share, options);
+    if (!increment.allFinite()) {
+      throw GeometryError(std::string("the ") + (options.method == ExtensionMethod::harmonic ? "harmonic" : "elastic") +
+                          " extension has no finite solution on this mesh" +
+                          (step > 0 ? " (substep " + std::to_string(step + 1) + " flattened a cell)" : ""));
+    }
+    total += increment;
+    moved += increment;
+  }
+  out.displacement = total;
   measure_inversions(out);
+}
+
+void require_options(const ExtendOptions& options) {
+  if (!(options.poisson_ratio >= 0.0 && options.poisson_ratio < 0.5)) {
+    detail::invalid("poisson_ratio", "must be at least 0 and below 0.5, got " + std::to_string(options.poisson_ratio));
+  }
+  if (options.substeps < 1) detail::invalid("substeps", "must be at least 1, got " + std::to_string(options.substeps));
+  if (!std::isfinite(options.mesh_size)) detail::invalid("mesh_size", "must be finite");
+}
+
+// The mesh size for Mesh_3: the one asked for, else the start triangles' mean edge (checking that
+// every corner has a start point, as the surface to mesh).
+double default_size(const DisplacementField3& field, const ExtendOptions& options) {
+  if (field.faces.rows() == 0) detail::invalid("field", "has no triangles to mesh the region they enclose");
+  double total = 0.0;
+  for (Index f = 0; f < field.faces.rows(); ++f) {
+    for (int i = 0; i < 3; ++i) {
+      const Index a = field.faces(f, i);
+      if (a < 0 || a >= field.starts.rows() || !field.starts.row(a).allFinite()) {
+        detail::invalid("field", "triangle " + std::to_string(f) + " has a corner without a start point: pass mesh=");
+      }
+    }
+    for (int i = 0; i < 3; ++i) {
+      total += (field.starts.row(field.faces(f, i)) - field.starts.row(field.faces(f, (i + 1) % 3))).norm();
+    }
+  }
+  return options.mesh_size > 0.0 ? options.mesh_size : total / (3.0 * field.faces.rows());
 }
 
 }  // namespace
 
 InteriorField2 extend_field(const DisplacementField2& field, const Points2Ref& source, const Points2Ref& mesh_points,
-                            const FacesRef& mesh_cells, double mesh_size) {
+                            const FacesRef& mesh_cells, const ExtendOptions& options) {
+  require_options(options);
   detail::require_simple_curve(source, true, "source");
-  if (!std::isfinite(mesh_size)) detail::invalid("mesh_size", "must be finite");
   InteriorField2 out;
   if (mesh_cells.rows() == 0) {
-    const detail::RegionMesh mesh = detail::mesh_region({detail::without_repeats(source, true, "source")}, mesh_size);
+    const detail::RegionMesh mesh =
+        detail::mesh_region({detail::without_repeats(source, true, "source")}, options.mesh_size);
     out.points = mesh.vertices;
     out.cells = mesh.triangles;
   } else {
@@ -144,27 +258,27 @@ InteriorField2 extend_field(const DisplacementField2& field, const Points2Ref& s
   }
   const std::vector<char> fixed = boundary_nodes(out.cells, out.points.rows());
   take_boundary_values(out, fixed, [&](const Points2& at) { return displacement_at(field, source, true, at); });
-  solve_harmonic(out, fixed, [&](Index t) {
-    Vec2 p[3];
-    for (int i = 0; i < 3; ++i) p[i] = out.points.row(out.cells(t, i)).transpose();
-    return detail::triangle_stiffness(p);
-  }, false);
+  solve_motion<2>(out, fixed, options);
   return out;
 }
 
 InteriorField3 extend_field(const DisplacementField3& field, const Points3Ref& mesh_points,
-                            const TetrahedraRef& mesh_cells) {
-  require_mesh(mesh_points, mesh_cells);
+                            const TetrahedraRef& mesh_cells, const ExtendOptions& options) {
+  require_options(options);
   InteriorField3 out;
-  out.points = mesh_points;
-  out.cells = mesh_cells;
+  if (mesh_cells.rows() == 0) {
+    const detail::VolumeMesh mesh = detail::mesh_volume(field.starts, field.faces, default_size(field, options),
+                                                        options.seed, "field");
+    out.points = mesh.vertices;
+    out.cells = mesh.tetrahedra;
+  } else {
+    require_mesh(mesh_points, mesh_cells);
+    out.points = mesh_points;
+    out.cells = mesh_cells;
+  }
   const std::vector<char> fixed = boundary_nodes(out.cells, out.points.rows());
   take_boundary_values(out, fixed, [&](const Points3& at) { return displacement_at(field, at); });
-  solve_harmonic(out, fixed, [&](Index t) {
-    Eigen::Matrix<double, 4, 3> g;
-    const double volume = std::abs(detail::tetrahedron_gradients(out.points, out.cells, t, g));
-    return Eigen::Matrix4d(volume * g * g.transpose());
-  }, true);
+  solve_motion<3>(out, fixed, options);
   return out;
 }
 

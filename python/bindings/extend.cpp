@@ -4,6 +4,8 @@
 
 #include <morphomap/extend.hpp>
 
+#include <string>
+
 #include "interrupt_guard.hpp"
 
 namespace py = pybind11;
@@ -17,34 +19,46 @@ py::tuple interior_tuple(Interior&& out) {
                         out.min_jacobian, out.boundary_distance);
 }
 
+ExtendOptions extend_options(const std::string& method, double poisson_ratio, int substeps, double mesh_size) {
+  ExtendOptions options;
+  options.method = method == "elastic" ? ExtensionMethod::elastic : ExtensionMethod::harmonic;
+  options.poisson_ratio = poisson_ratio;
+  options.substeps = substeps;
+  options.mesh_size = mesh_size;
+  return options;
+}
+
 }  // namespace
 
 void bind_extend(py::module_& m) {
   m.def(
       "extend_field_2d",
       [](const Points2Ref& starts, const Points2Ref& ends, const Points2Ref& source, const Points2Ref& points,
-         const FacesRef& cells, double mesh_size) {
+         const FacesRef& cells, const std::string& method, double poisson_ratio, int substeps, double mesh_size) {
+        const ExtendOptions options = extend_options(method, poisson_ratio, substeps, mesh_size);
         InteriorField2 out;
         InterruptGuard interruptible;
         {
           py::gil_scoped_release release;
-          out = extend_field(DisplacementField2{starts, ends, {}}, source, points, cells, mesh_size);
+          out = extend_field(DisplacementField2{starts, ends, {}}, source, points, cells, options);
         }
         return interior_tuple(std::move(out));
       },
       py::arg("starts"), py::arg("ends"), py::arg("source"), py::arg("points"), py::arg("cells"),
-      py::arg("mesh_size"));
+      py::arg("method"), py::arg("poisson_ratio"), py::arg("substeps"), py::arg("mesh_size"));
   m.def(
       "extend_field_3d",
       [](const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, const Points3Ref& points,
-         const TetrahedraRef& cells) {
+         const TetrahedraRef& cells, const std::string& method, double poisson_ratio, int substeps, double mesh_size) {
+        const ExtendOptions options = extend_options(method, poisson_ratio, substeps, mesh_size);
         InteriorField3 out;
         InterruptGuard interruptible;
         {
           py::gil_scoped_release release;
-          out = extend_field(DisplacementField3{starts, ends, faces, {}}, points, cells);
+          out = extend_field(DisplacementField3{starts, ends, faces, {}}, points, cells, options);
         }
         return interior_tuple(std::move(out));
       },
-      py::arg("starts"), py::arg("ends"), py::arg("faces"), py::arg("points"), py::arg("cells"));
+      py::arg("starts"), py::arg("ends"), py::arg("faces"), py::arg("points"), py::arg("cells"),
+      py::arg("method"), py::arg("poisson_ratio"), py::arg("substeps"), py::arg("mesh_size"));
 }

@@ -121,7 +121,8 @@ def _extend(args, parser) -> int:
             parser.error(f"{args.mesh}: has no {kind} cells (found: {', '.join(solver_mesh.cells_dict) or 'none'})")
         mesh = (solver_mesh.points[:, : field.dim], solver_mesh.cells_dict[kind])
     try:
-        interior = morphomap.extend_field(field, mesh=mesh, mesh_size=args.extend_mesh_size)
+        interior = morphomap.extend_field(field, mesh=mesh, mesh_size=args.extend_mesh_size, method=args.extension,
+                                          poisson_ratio=args.poisson_ratio, substeps=args.substeps)
     except (ValueError, TypeError, morphomap.InvalidInput, morphomap.GeometryError) as error:
         parser.error(f"cannot extend the field into {args.mesh or 'the domain'}: {error}")
     try:
@@ -271,12 +272,19 @@ def main(argv=None) -> int:
     extend = commands.add_parser(
         "extend", parents=[common],
         help="map C1 onto C2 and extend the field into the domain C1 encloses (the solver's mesh motion)",
-        description="Map boundary C1 onto C2 as `map` does, then extend the displacement harmonically into the "
-                    "domain C1 encloses: on the solver's own mesh (--mesh, triangles in 2D, tetrahedra in 3D, any "
-                    "file meshio reads) or, in 2D, on a mesh made by CGAL. Writes the interior displacement.")
+        description="Map boundary C1 onto C2 as `map` does, then extend the displacement (harmonic or elastic) into "
+                    "the domain C1 encloses: on the solver's own mesh (--mesh, triangles in 2D, tetrahedra in 3D, any "
+                    "file meshio reads) or on a mesh made by CGAL. Writes the interior displacement.")
     extend.add_argument("--mesh", metavar="MESH", help="the solver's mesh of the domain (.xdmf, .vtu, .msh, ...)")
     extend.add_argument("--extend-mesh-size", type=lambda text: _length(text, positive=True), default=None,
-                        metavar="H", help="2D without --mesh: the largest edge of the mesh made (default: graded)")
+                        metavar="H", help="without --mesh: the largest edge of the mesh made (default: graded in 2D, "
+                                          "S1's mean edge in 3D)")
+    extend.add_argument("--extension", choices=("harmonic", "elastic"), default="harmonic",
+                        help="the interior problem: a vector Laplace equation or linear elasticity")
+    extend.add_argument("--poisson-ratio", type=float, default=0.3, metavar="NU",
+                        help="--extension elastic: the Poisson ratio, 0 <= NU < 0.5 (default 0.3)")
+    extend.add_argument("--substeps", type=int, default=1, metavar="K",
+                        help="move the mesh in K steps, each solved on the moved mesh (fewer inverted cells)")
     extend.add_argument("--dt", type=lambda text: _length(text, positive=True), default=None, metavar="DT",
                         help="the time between the frames: also write the velocity")
     extend.add_argument("-o", "--output", required=True, metavar="U.xdmf",

@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+import numbers
+
 import numpy as np
 
 from . import _core
-from ._validate import as_choice, as_length, as_points
+from ._validate import as_choice, as_count, as_length, as_points
 from .field import DisplacementField
 
-EXTENSION_METHODS = ("harmonic",)
+EXTENSION_METHODS = ("harmonic", "elastic")
 
 
 class InteriorField:
@@ -21,7 +23,7 @@ class InteriorField:
     cells : (C, d + 1) int64
         Triangles (2D) or tetrahedra (3D).
     displacement : (P, d) float
-        At every node: the boundary field at the boundary nodes, harmonic inside.
+        At every node: the boundary field at the boundary nodes, the method's solution inside.
     inverted : int
         Cells that the motion ``x -> x + displacement`` turns over or flattens.
     min_jacobian : float
@@ -60,7 +62,17 @@ class InteriorField:
                 f"min jacobian {self.min_jacobian:.3g})")
 
 
-def extend_field(field, boundary=None, *, method="harmonic", mesh=None, mesh_size=None) -> InteriorField:
+def _poisson_ratio(value) -> float:
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise TypeError(f"poisson_ratio: expected a number, got {type(value).__name__}")
+    value = float(value)
+    if not 0.0 <= value < 0.5:
+        raise ValueError(f"poisson_ratio: must be at least 0 and below 0.5, got {value}")
+    return value
+
+
+def extend_field(field, boundary=None, *, method="harmonic", mesh=None, mesh_size=None, poisson_ratio=0.3,
+                 substeps=1) -> InteriorField:
     """Extend a boundary displacement field to the domain the source boundary encloses.
 
     Parameters
@@ -70,18 +82,32 @@ def extend_field(field, boundary=None, *, method="harmonic", mesh=None, mesh_siz
     boundary : (N, 2) float, optional
         2D: the source curve C1 (closed); by default the curve the field was made from.
         3D: unused (the field's start triangles are the boundary).
-    method : "harmonic"
-        Each component of the displacement solves the Laplace equation inside (P1 finite
-        elements in the C++ core), equal to the field on the boundary: an affine boundary map
-        extends to the same affine map.
+    method : "harmonic" or "elastic"
+        ``"harmonic"``: each component of the displacement solves the Laplace equation inside.
+        ``"elastic"``: the displacement solves isotropic linear elasticity with the given
+        ``poisson_ratio``. Either way P1 finite elements in the C++ core, equal to the field on
+        the boundary: an affine boundary map extends to the same affine map.
     mesh : (points, cells), optional
         The solver's own mesh: triangles (2D) or tetrahedra (3D). Its boundary nodes (on an edge
         or face of one cell only) are projected onto the source boundary and take the field
         there (:meth:`DisplacementField.at`); ``boundary_distance`` says how far they were. 2D
         without a mesh: the domain is meshed with CGAL's constrained Delaunay mesher, every
-        point of C1 a node. 3D needs the mesh.
+        point of C1 a node. 3D without a mesh: the region S1 (the field's start triangles, a
+        closed surface) encloses is meshed with CGAL's Mesh_3, its surface nodes on S1's
+        triangles, every tetrahedron with a node inside (one with four corners on S1 would move
+        with the boundary field alone); the mesher's random choices are fixed, so the same field
+        gives the same mesh.
     mesh_size : float, optional
-        2D without a mesh: the largest edge (default: graded from C1's point spacing).
+        Without a mesh, 2D: the largest edge (default: graded from C1's point spacing); 3D: the
+        edge length of the tetrahedra and surface triangles (default: S1's mean edge).
+    poisson_ratio : float
+        ``"elastic"`` only: 0 <= nu < 0.5 (near 0.5 the interior resists changes of volume).
+    substeps : int
+        Move the mesh in this many equal steps of the boundary displacement, each solved on the
+        mesh as the steps before have moved it (the returned displacement is their sum). Large
+        growth steps invert cells under a single solve; substeps let the interior follow (the
+        kidney pair, diffusion field: 17 of 345,011 triangles inverted by one solve, none with 4
+        substeps; bench/README.md). Cells that the boundary field itself folds stay inverted.
 
     Returns
     -------
@@ -90,6 +116,8 @@ def extend_field(field, boundary=None, *, method="harmonic", mesh=None, mesh_siz
     if not isinstance(field, DisplacementField):
         raise TypeError(f"field: expected a DisplacementField, got {type(field).__name__}")
     as_choice(method, "method", EXTENSION_METHODS)
+    options = dict(method=method, poisson_ratio=_poisson_ratio(poisson_ratio),
+                   substeps=as_count(substeps, "substeps", 1))
     if mesh is not None:
         if not (isinstance(mesh, (tuple, list)) and len(mesh) == 2):
             raise TypeError("mesh: expected a (points, cells) pair")
@@ -100,11 +128,12 @@ def extend_field(field, boundary=None, *, method="harmonic", mesh=None, mesh_siz
                              f"{cells.shape}")
         cells = np.ascontiguousarray(cells, dtype=np.int64)
     if field.dim == 3:
-        if mesh is None:
-            raise ValueError("mesh: 3D needs the solver's tetrahedral mesh of the domain, mesh=(points, cells)")
         if field.faces is None:
             raise ValueError("field: a 3D field needs its faces")
-        result = _core.extend_field_3d(field.starts, field.ends, field.faces, points, cells)
+        if mesh is None:
+            points, cells = np.zeros((0, 3)), np.zeros((0, 4), dtype=np.int64)
+        result = _core.extend_field_3d(field.starts, field.ends, field.faces, points, cells,
+                                       mesh_size=as_length(mesh_size, "mesh_size", 0.0), **options)
     else:
         source = field.source if boundary is None else boundary
         if source is None:
@@ -112,5 +141,5 @@ def extend_field(field, boundary=None, *, method="harmonic", mesh=None, mesh_siz
         if mesh is None:
             points, cells = np.zeros((0, 2)), np.zeros((0, 3), dtype=np.int64)
         result = _core.extend_field_2d(field.starts, field.ends, as_points(source, "boundary", 2), points, cells,
-                                       as_length(mesh_size, "mesh_size", 0.0))
+                                       mesh_size=as_length(mesh_size, "mesh_size", 0.0), **options)
     return InteriorField(*result)

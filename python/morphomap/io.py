@@ -126,9 +126,9 @@ def write_curve(path, points, *, header=True) -> None:
 
 
 def write_field(path, field: DisplacementField, *, dt=None) -> None:
-    """Write a displacement field; the format from the suffix: ``.csv`` (below), ``.vtu``,
-    ``.xdmf`` or a COMSOL ``.txt`` table (:mod:`morphomap.solver_files`; ``dt`` adds the velocity
-    there).
+    """Write a displacement field; the format from the suffix: ``.csv`` (below), ``.vtu``, ``.vtp``
+    (needs the optional ``vtk`` package), ``.xdmf`` or a COMSOL ``.txt`` table
+    (:mod:`morphomap.solver_files`; ``dt`` adds the velocity there).
 
     CSV: ``start_x,start_y,end_x,end_y,valid,method`` per vector.
 
@@ -140,10 +140,10 @@ def write_field(path, field: DisplacementField, *, dt=None) -> None:
     if not isinstance(field, DisplacementField):
         raise TypeError(f"field: expected a DisplacementField, got {type(field).__name__}")
     if not hasattr(path, "write"):
-        from .solver_files import SOLVER_SUFFIXES, write_field_for_solver
+        from .solver_files import FIELD_SUFFIXES, write_field_for_solver
 
         suffix = os.path.splitext(os.fspath(path))[1].lower()
-        if suffix in SOLVER_SUFFIXES:
+        if suffix in FIELD_SUFFIXES:
             write_field_for_solver(path, field, dt)
             return
     header = _FIELD_2D if field.dim == 2 else _FIELD_3D

@@ -1,10 +1,12 @@
 """Fields and interior displacements in the files PDE solvers and viewers read.
 
-By suffix: ``.vtu`` (VTK unstructured grid: ParaView), ``.xdmf`` (+ ``.h5`` beside it: FEniCSx,
-ParaView), ``.txt`` (a COMSOL interpolation table, spreadsheet format). meshio writes VTK and
-XDMF. Point data: ``displacement`` (and ``velocity`` when a time step is given), for boundary
-fields also ``end``, ``valid`` (1/0) and ``method`` (an index into
-:data:`morphomap.field.METHOD_NAMES`, written into the file's comments or field data). 2D vectors
+By suffix: ``.vtu`` (VTK unstructured grid: ParaView), ``.vtp`` (VTK PolyData, boundary fields
+only: their triangles or points), ``.xdmf`` (+ ``.h5`` beside it: FEniCSx, ParaView), ``.txt`` (a
+COMSOL interpolation table, spreadsheet format). meshio writes ``.vtu`` and XDMF; ``.vtp`` needs
+the optional ``vtk`` package (``pip install morphomap[vtk]``; meshio has no PolyData writer).
+Point data: ``displacement`` (and ``velocity`` when a time step is given), for boundary fields
+also ``end``, ``valid`` (1/0) and ``method`` (an index into :data:`morphomap.field.METHOD_NAMES`,
+written into the file's comments or field data). 2D vectors
 get a zero third component in VTK files (ParaView's vectors are 3D) and stay 2D in XDMF (FEniCSx
 meshes of the plane).
 
@@ -34,27 +36,83 @@ from ._validate import as_length
 from .field import METHOD_NAMES, DisplacementField
 
 SOLVER_SUFFIXES = (".vtu", ".xdmf", ".txt")
+FIELD_SUFFIXES = SOLVER_SUFFIXES + (".vtp",)  # PolyData: a boundary, not a volume
+
+
+def _atomic_files(path, write):
+    """write(temporary path) in a scratch folder beside `path`, then everything it wrote renamed
+    into place, the file named `path` last (it may refer to the others)."""
+    target = os.path.abspath(os.fspath(path))
+    folder, name = os.path.split(target)
+    scratch = tempfile.mkdtemp(dir=folder, prefix=f".{name}.")
+    try:
+        write(os.path.join(scratch, name))
+        written = sorted(os.listdir(scratch), key=lambda f: f == name)
+        for file in written:
+            os.replace(os.path.join(scratch, file), os.path.join(folder, file))
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
+
+
+def _flat_to_3d(points, point_data):
+    """VTK's points and vectors are 3D: 2D ones get a zero third component."""
+    if points.shape[1] != 2:
+        return points, point_data
+    pad = lambda v: np.column_stack([v, np.zeros(len(v))]) if v.ndim == 2 and v.shape[1] == 2 else v  # noqa: E731
+    return pad(points), {k: pad(v) for k, v in point_data.items()}
+
+
+def _poly_data_file(path, points, cells, point_data, field_data):
+    try:
+        from vtkmodules.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
+        from vtkmodules.vtkCommonCore import vtkPoints
+        from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
+        from vtkmodules.vtkIOXML import vtkXMLPolyDataWriter
+    except ImportError as error:
+        raise ImportError("path: .vtp files need the optional vtk package (pip install vtk)") from error
+
+    points, point_data = _flat_to_3d(points, point_data)
+    poly = vtkPolyData()
+    vtk_points = vtkPoints()
+    vtk_points.SetData(numpy_to_vtk(np.ascontiguousarray(points, dtype=np.float64), deep=True))
+    poly.SetPoints(vtk_points)
+    corners = cells.shape[1]
+    offsets = np.arange(0, corners * len(cells) + 1, corners, dtype=np.int64)
+    cell_array = vtkCellArray()
+    cell_array.SetData(numpy_to_vtkIdTypeArray(offsets, deep=True),
+                       numpy_to_vtkIdTypeArray(np.ascontiguousarray(cells, dtype=np.int64).ravel(), deep=True))
+    (poly.SetPolys if corners == 3 else poly.SetVerts)(cell_array)
+    for name, values in point_data.items():
+        array = numpy_to_vtk(np.ascontiguousarray(values), deep=True)
+        array.SetName(name)
+        poly.GetPointData().AddArray(array)
+    for name, values in field_data.items():
+        array = numpy_to_vtk(np.ascontiguousarray(values), deep=True)
+        array.SetName(name)
+        poly.GetFieldData().AddArray(array)
+
+    def write(temporary):
+        writer = vtkXMLPolyDataWriter()
+        writer.SetFileName(temporary)
+        writer.SetInputData(poly)
+        if writer.Write() != 1:
+            raise OSError(f"VTK could not write {path}")
+
+    _atomic_files(path, write)
 
 
 def _mesh_file(path, points, cells, cell_type, point_data, field_data=None):
     import meshio
 
     suffix = os.path.splitext(os.fspath(path))[1].lower()
-    if suffix == ".vtu" and points.shape[1] == 2:
-        points = np.column_stack([points, np.zeros(len(points))])
-        point_data = {k: (np.column_stack([v, np.zeros(len(v))]) if v.ndim == 2 and v.shape[1] == 2 else v)
-                      for k, v in point_data.items()}
+    if suffix == ".vtp":
+        _poly_data_file(path, points, cells, point_data, field_data or {})
+        return
+    if suffix == ".vtu":
+        points, point_data = _flat_to_3d(points, point_data)
     mesh = meshio.Mesh(points, [(cell_type, cells)], point_data=point_data, field_data=field_data or {})
-    target = os.path.abspath(os.fspath(path))
-    folder, name = os.path.split(target)
-    scratch = tempfile.mkdtemp(dir=folder, prefix=f".{name}.")
-    try:
-        meshio.write(os.path.join(scratch, name), mesh, file_format="xdmf" if suffix == ".xdmf" else "vtu")
-        written = sorted(os.listdir(scratch), key=lambda f: f == name)  # the file referring to the others last
-        for file in written:
-            os.replace(os.path.join(scratch, file), os.path.join(folder, file))
-    finally:
-        shutil.rmtree(scratch, ignore_errors=True)
+    _atomic_files(path, lambda temporary: meshio.write(temporary, mesh,
+                                                       file_format="xdmf" if suffix == ".xdmf" else "vtu"))
 
 
 def _comsol_table(path, header, points, displacement):
@@ -74,7 +132,7 @@ def _velocity(displacement, dt):
 
 
 def write_field_for_solver(path, field: DisplacementField, dt=None) -> None:
-    """A boundary field as ``.vtu``, ``.xdmf`` or a COMSOL ``.txt`` (see the module's notes).
+    """A boundary field as ``.vtu``, ``.vtp``, ``.xdmf`` or a COMSOL ``.txt`` (see the module's notes).
 
     The points are the start points (rows whose start is unknown, from a reverse mapping that
     missed, are left out); 3D fields carry their triangles, 2D fields are written as points.

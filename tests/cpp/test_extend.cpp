@@ -11,6 +11,8 @@
 using morphomap::DisplacementField2;
 using morphomap::DisplacementField3;
 using morphomap::extend_field;
+using morphomap::ExtendOptions;
+using morphomap::ExtensionMethod;
 using morphomap::Faces;
 using morphomap::Index;
 using morphomap::InvalidInput;
@@ -32,14 +34,21 @@ void test_2d() {
   const Eigen::RowVector2d b(0.3, -0.2);
   const Points2 ends = (c1 * a.transpose()).rowwise() + b;
   const DisplacementField2 field{c1, ends, {}};
-  const auto out = extend_field(field, c1, Points2(0, 2), Faces(0, 3), 0.2);
-  CHECK(out.points.rows() > n && out.inverted == 0);
-  const Points2 expected = ((out.points * a.transpose()).rowwise() + b) - out.points;
-  CHECK((out.displacement - expected).cwiseAbs().maxCoeff() < 1e-10);
-  CHECK(std::abs(out.min_jacobian - a.determinant()) < 1e-9);
+  ExtendOptions options;
+  options.mesh_size = 0.2;
+  for (const auto method : {ExtensionMethod::harmonic, ExtensionMethod::elastic}) {
+    options.method = method;
+    const auto out = extend_field(field, c1, Points2(0, 2), Faces(0, 3), options);
+    CHECK(out.points.rows() > n && out.inverted == 0);
+    const Points2 expected = ((out.points * a.transpose()).rowwise() + b) - out.points;
+    CHECK((out.displacement - expected).cwiseAbs().maxCoeff() < 1e-10);
+    CHECK(std::abs(out.min_jacobian - a.determinant()) < 1e-9);
+  }
   Faces bad(1, 3);
   bad << 0, 1, 1000;
-  CHECK_THROWS(extend_field(field, c1, c1, bad, 0.0), InvalidInput);
+  CHECK_THROWS(extend_field(field, c1, c1, bad), InvalidInput);
+  options.poisson_ratio = 0.5;
+  CHECK_THROWS(extend_field(field, c1, Points2(0, 2), Faces(0, 3), options), InvalidInput);
 }
 
 void test_3d() {
@@ -55,10 +64,21 @@ void test_3d() {
   a << 1.1, 0.2, 0, -0.1, 0.9, 0.1, 0.3, 0, 1.2;
   const Points3 corners = points.topRows(8);
   const DisplacementField3 field{corners, corners * a.transpose(), faces, {}};
-  const auto out = extend_field(field, points, cells);
-  const Points3 expected = points * a.transpose() - points;
-  CHECK((out.displacement - expected).cwiseAbs().maxCoeff() < 1e-10);
-  CHECK(out.inverted == 0 && out.boundary_distance < 1e-12);
+  ExtendOptions options;
+  for (const auto method : {ExtensionMethod::harmonic, ExtensionMethod::elastic}) {
+    options.method = method;
+    const auto out = extend_field(field, points, cells, options);
+    const Points3 expected = points * a.transpose() - points;
+    CHECK((out.displacement - expected).cwiseAbs().maxCoeff() < 1e-10);
+    CHECK(out.inverted == 0 && out.boundary_distance < 1e-12);
+  }
+  // No mesh given: Mesh_3 fills the cube, its surface nodes on the cube's faces.
+  options.mesh_size = 0.3;
+  const auto filled = extend_field(field, Points3(0, 3), Tetrahedra(0, 4), options);
+  CHECK(filled.points.rows() > 8);
+  const Points3 expected = filled.points * a.transpose() - filled.points;
+  CHECK((filled.displacement - expected).cwiseAbs().maxCoeff() < 1e-10);
+  CHECK(filled.inverted == 0 && filled.boundary_distance < 1e-12);
 }
 
 }  // namespace

@@ -24,20 +24,39 @@ struct InteriorField3 {
   double boundary_distance = 0.0;  // farthest boundary node from the start triangles
 };
 
-// The harmonic extension: each component of the displacement solves the Laplace equation inside
-// (P1 finite elements, sparse LDL^T), equal at the mesh's boundary nodes (those on an edge of one
-// triangle only) to the field there (displacement_at: the nodes are projected onto the source
-// curve C1, which must be closed). An affine boundary map extends to the same affine map.
-// mesh_cells empty: the region C1 encloses is meshed with CGAL's constrained Delaunay mesher,
-// every point of C1 a node, edges at most mesh_size (<= 0: graded from C1's point spacing).
-// Throws InvalidInput naming "source", "mesh" or "field" (e.g. a boundary node without a
-// displacement, where the field missed).
-InteriorField2 extend_field(const DisplacementField2& field, const Points2Ref& source, const Points2Ref& mesh_points,
-                            const FacesRef& mesh_cells, double mesh_size = 0.0);
+enum class ExtensionMethod {
+  harmonic,  // each component solves the Laplace equation
+  elastic,   // the displacement solves linear elasticity (isotropic, the given Poisson ratio)
+};
 
-// The same in 3D on a tetrahedral mesh (boundary nodes: those on a face of one tetrahedron only),
-// the boundary displacement interpolated over the field's start triangles.
+struct ExtendOptions {
+  ExtensionMethod method = ExtensionMethod::harmonic;
+  double poisson_ratio = 0.3;  // elastic: 0 <= nu < 0.5 (Young's modulus cancels out)
+  // The motion in `substeps` equal steps of the boundary displacement, each solved on the mesh as
+  // the steps before have moved it (1: one solve on the mesh as given). Large growth steps invert
+  // cells under one solve; re-solving on the moving mesh lets the interior follow the boundary.
+  int substeps = 1;
+  // No mesh given: the largest edge of the mesh made (<= 0: graded from the boundary's spacing).
+  double mesh_size = 0.0;
+  int seed = 0;  // 3D without a mesh: of Mesh_3's random choices (the same seed, the same mesh)
+};
+
+// The extension: the displacement at the mesh's boundary nodes (those on an edge of one triangle
+// or a face of one tetrahedron only) is the field there (displacement_at: 2D nodes are projected
+// onto the source curve C1, which must be closed; 3D nodes onto the field's start triangles), and
+// inside it solves the method's equations (P1 finite elements, sparse Cholesky in 2D, conjugate
+// gradients first in 3D). Either method extends an affine boundary map to the same affine map.
+// 2D, mesh_cells empty: the region C1 encloses is meshed with CGAL's constrained Delaunay mesher,
+// every point of C1 a node, edges at most mesh_size (<= 0: graded from C1's point spacing).
+// 3D, mesh_cells empty: the region the start triangles enclose (a closed surface) is meshed with
+// CGAL's Mesh_3 (its surface nodes lie on the triangles; no tetrahedron has all four corners on
+// them, so that none moves with the boundary field alone).
+// Throws InvalidInput naming "source", "mesh", "field", "poisson_ratio", "substeps" or
+// "mesh_size" (e.g. a boundary node without a displacement, where the field missed).
+InteriorField2 extend_field(const DisplacementField2& field, const Points2Ref& source, const Points2Ref& mesh_points,
+                            const FacesRef& mesh_cells, const ExtendOptions& options = {});
+
 InteriorField3 extend_field(const DisplacementField3& field, const Points3Ref& mesh_points,
-                            const TetrahedraRef& mesh_cells);
+                            const TetrahedraRef& mesh_cells, const ExtendOptions& options = {});
 
 }  // namespace morphomap
