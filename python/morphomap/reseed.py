@@ -98,7 +98,9 @@ def reseed_surface(points, faces, growth, frame, limit):
         if not (lengths > limit).any():
             break
         pairs = np.sort(np.stack([faces, faces[:, [1, 2, 0]]], axis=2).reshape(-1, 2), axis=1)
-        keys, edge_of = np.unique(pairs, axis=0, return_inverse=True)
+        # One integer per edge (a 1D unique is many times faster than a unique over rows).
+        codes, edge_of = np.unique(pairs[:, 0] * len(every) + pairs[:, 1], return_inverse=True)
+        keys = np.column_stack([codes // len(every), codes % len(every)])
         edge_of = edge_of.reshape(-1, 3)
         edge_length = np.zeros(len(keys))
         edge_length[edge_of.ravel()] = lengths.ravel()
