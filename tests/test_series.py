@@ -94,6 +94,17 @@ def test_reseeding_keeps_a_budding_curve_sampled():
     assert (lengths / kept.accumulated_stretch(-1)).sum() == pytest.approx(mm.perimeter(frames[0]), rel=1e-2)
 
 
+@pytest.mark.parametrize("clockwise", [False, True])
+def test_new_points_sit_between_their_neighbours(clockwise):
+    frames = [circle(60, r, clockwise=clockwise) for r in (1.0, 1.5, 2.5)]
+    series = mm.map_series(frames, "normal", progress=False)
+    assert (series.born[60:] == 2).all() and len(series.born) == 180  # 2.5 spacings: 2 new points a piece
+    points = series.trajectories[-1][series.cells[-1]]
+    angles = np.angle(np.exp(1j * np.diff(np.arctan2(points[..., 1], points[..., 0]), axis=1)))
+    assert np.allclose(np.abs(angles), 2 * np.pi / 180, rtol=2e-3)  # a third of an old piece (in arc length)
+    assert np.allclose(np.sign(angles), -1 if clockwise else 1)  # in the frames' own order
+
+
 def test_growth_maps_of_growing_circles_are_the_radius_ratios():
     radii, dt = [1.0, 1.5, 2.5], 0.5
     series = mm.map_series([circle(300, r) for r in radii], "normal", dt=dt, reseed=None, progress=False)

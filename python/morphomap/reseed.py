@@ -22,14 +22,16 @@ def reseed_curve(points, chain, growth, frame, spacing, limit, closed):
     chain : (K,) int, the alive points in their order along the boundary.
     growth : (P,) float, the accumulated stretch of each piece (piece i runs from chain[i] to the
         next point; P = K closed, K - 1 open).
-    frame : (N, 2) float, the boundary of this frame.
+    frame : (N, 2) float, the boundary of this frame. A piece's length is the arc length along it
+        between its two points' closest points (the shorter way round a closed frame), and its new
+        points are equally spaced along that arc.
     spacing : the spacing new points are placed at (pieces longer than ``limit`` are cut into
         equal parts no longer than ``spacing``).
 
     Returns ``(new_points (B, 2), chain, growth)``: the new points get the ids ``M``, ``M + 1``, ...
     in that order and sit in ``chain`` between the two points whose piece they split.
     """
-    from .curves import orientation, perimeter
+    from .curves import perimeter
     from .queries import CurveIndex
 
     pieces = len(chain) if closed else len(chain) - 1
@@ -38,23 +40,22 @@ def reseed_curve(points, chain, growth, frame, spacing, limit, closed):
     index = CurveIndex(frame, closed=closed)
     along = index.closest_points(points[chain]).arc_lengths
     total = perimeter(frame, closed=closed)
-    # The followed points run along the frame's own direction, or against it.
-    if closed:
-        forward = len(chain) < 3 or orientation(points[chain]) == orientation(frame)
-    else:
-        forward = np.median(np.diff(along)) >= 0
     start = along[:pieces]
     end = np.roll(along, -1)[:pieces] if closed else along[1:]
-    arc = end - start if forward else start - end
+    # Each piece runs the shorter way round between its two points (on an open curve, the only
+    # way): whichever way the frame runs, and robust to two neighbours that swapped places.
+    arc = np.mod(end - start, total) if closed else np.abs(end - start)
+    way = np.ones(pieces) if closed else np.sign(end - start)
     if closed:
-        arc = np.mod(arc, total)
+        back = arc > total / 2
+        arc[back], way[back] = total - arc[back], -1.0
     counts = np.where(arc > limit, np.ceil(arc / spacing).astype(np.int64) - 1, 0)
     if not counts.any():
         return np.empty((0, 2)), chain, growth
     # Arc-length positions of the new points: equal parts of each piece that is split.
     owner = np.repeat(np.arange(pieces), counts)
     rank = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts) + 1
-    step = arc[owner] / (counts[owner] + 1) * (1 if forward else -1)
+    step = arc[owner] / (counts[owner] + 1) * way[owner]
     positions = start[owner] + rank * step
     vertices = np.vstack([frame, frame[:1]]) if closed else frame
     knots = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(vertices, axis=0), axis=1))])

@@ -238,9 +238,9 @@ def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **op
         between neighbouring points: consecutive curve points, or surface edges), new material
         points are born on that frame's boundary between them, spaced at most the spacing of
         frame 0 apart. 2D: the distance is the arc length along the frame between the two points'
-        closest points, and the new points are equally spaced along that arc. 3D: every triangle
-        edge longer than the limit is split at its middle, moved onto the frame's surface (the two
-        triangles sharing it become four), until no edge is longer. New points are followed from
+        closest points (the shorter way round), and the new points are equally spaced along that
+        arc. 3D: every triangle edge longer than the limit is split at its middle, moved onto the
+        frame's surface (the two triangles sharing it become four), until no edge is longer. New points are followed from
         then on (their rows of ``trajectories`` are NaN before; ``born`` gives their frame).
         ``None`` follows only the points of frame 0. Default 2.
     progress : bool, optional
