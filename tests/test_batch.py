@@ -59,3 +59,15 @@ def test_a_dead_worker_fails_its_job_only(frames):
     results = mm.map_batch(jobs, workers=2, progress=False, task=task)
     assert results[0].status == "failed" and "KilledWorker" in results[0].message
     assert results[1].status == "done" and np.isfinite(mm.read_field(folder / "fine.csv").ends).all()
+
+
+def test_progress_bar_only_when_asked(frames, capfd):
+    require_client(HAVE_DASK, "Dask distributed")
+    folder, paths = frames
+    jobs = [Job(paths[k], paths[k + 1], str(folder / f"p{k}.csv")) for k in range(2)]
+    mm.map_batch(jobs, workers=2, progress=True)
+    assert "map_batch: 100%" in capfd.readouterr().err
+    jobs = [Job(paths[k], paths[k + 1], str(folder / f"q{k}.csv")) for k in range(2)]
+    mm.map_batch(jobs[:1], workers=1, progress=False)
+    mm.map_batch(jobs[1:], workers=1)  # stderr is not a terminal here
+    assert "map_batch" not in capfd.readouterr().err

@@ -170,3 +170,32 @@ def test_series_and_batch_commands(tmp_path):
     done = subprocess.run(command, capture_output=True, text=True)
     assert done.returncode == 1 and "3 jobs: 2 done or skipped, 1 failed" in done.stderr, done.stderr
     assert mm.read_field(tmp_path / "b" / "002_t1_t2.csv").method[0] == "diffusion"
+
+
+def test_series_command_writes_growth_maps_figures_and_animation(tmp_path):
+    import numpy as np
+    from PIL import Image
+
+    from conftest import circle
+
+    paths = []
+    for k, radius in enumerate((1.0, 1.5, 2.5)):
+        paths.append(tmp_path / f"t{k}.csv")
+        mm.write_curve(paths[-1], circle(60, radius))
+    done = subprocess.run([sys.executable, "-m", "morphomap", "series", *map(str, paths), "--method", "normal",
+                           "--dt", "0.5", "--no-progress", "--out", str(tmp_path / "s")], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    out = tmp_path / "s"
+    born = np.loadtxt(out / "points.csv", delimiter=",", skiprows=1)
+    assert (born[:60, 1] == 0).all() and (born[60:, 1] == 2).all() and len(born) == 180  # 2 new points a piece
+    speeds = np.loadtxt(out / "normal_speed.csv", delimiter=",", skiprows=1)
+    assert np.allclose(speeds[speeds[:, 0] == 1, 2], 2.0)  # (2.5 - 1.5) / 0.5
+    stretch = np.loadtxt(out / "stretch.csv", delimiter=",", skiprows=1)
+    assert np.allclose(stretch[stretch[:, 0] == 1, -1], 2.5)
+    for name in ("trajectories.png", "stretch.png", "normal_speed.png"):
+        assert Image.open(out / name).format == "PNG"
+    with Image.open(out / "series.gif") as gif:
+        assert gif.n_frames == 3
+    bad = subprocess.run([sys.executable, "-m", "morphomap", "series", *map(str, paths), "--reseed", "1",
+                          "--out", str(out)], capture_output=True, text=True)
+    assert bad.returncode == 2 and "expected a factor > 1 or 'none'" in bad.stderr

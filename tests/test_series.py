@@ -13,7 +13,7 @@ def test_circles_keep_their_angle_and_reach_each_radius():
     # lies on every frame's circle; the stretch of each step is the radius ratio.
     radii = [1.0, 1.5, 2.0, 2.5]
     frames = [circle(200, r) for r in radii]
-    series = mm.map_series(frames, "normal", progress=False)
+    series = mm.map_series(frames, "normal", reseed=None, progress=False)
     assert len(series.fields) == 3 and series.trajectories.shape == (4, 200, 2)
     for t, r in enumerate(radii):
         assert np.abs(np.linalg.norm(series.trajectories[t], axis=1) - r).max() < 1e-12
@@ -28,8 +28,9 @@ def test_spheres_and_writing(tmp_path):
     series = mm.map_series(frames, "normal", progress=False)
     assert np.abs(np.linalg.norm(series.trajectories[-1], axis=1) - 1.4).max() < 2e-3  # faceted spheres
     assert series.stretch(1).mean() == pytest.approx((1.4 / 1.2) ** 2, rel=1e-2)
-    paths = series.write(tmp_path / "out")
-    assert [p.split("/")[-1] for p in paths] == ["field_00.csv", "field_01.csv", "trajectories.csv", "quality.csv"]
+    paths = series.write(tmp_path / "out", figures=False)
+    assert [p.split("/")[-1] for p in paths] == ["field_00.csv", "field_01.csv", "trajectories.csv", "quality.csv",
+                                                 "points.csv", "stretch.csv", "normal_speed.csv"]
     back = mm.read_field(paths[1])
     assert back.faces is not None and np.allclose(back.vectors, series.fields[1].vectors)
     table = np.loadtxt(paths[2], delimiter=",", skiprows=1)
@@ -45,3 +46,150 @@ def test_bad_frames_are_named():
         mm.map_series([c1, trimesh.creation.icosphere(1)])
     with pytest.raises(ValueError, match=r"frames\[1\] -> frames\[2\]"):
         mm.map_series([c1, 2 * c1, np.vstack([c1, c1 + 5])])
+
+
+def budding(t, n=720):
+    """A circle at t = 0 that grows three buds: r = 1 + 0.1 t + 0.12 t^2 * sum of bumps."""
+    theta = 2 * np.pi * np.arange(n) / n
+    bumps = sum(np.exp(-(np.angle(np.exp(1j * (theta - c))) / 0.3) ** 2) for c in (0.3, 2.4, 4.5))
+    r = 1 + 0.1 * t + 0.12 * t**2 * bumps
+    return np.column_stack([r * np.cos(theta), r * np.sin(theta)])
+
+
+def largest_gap(points, curve):
+    """The largest arc length along ``curve`` between neighbouring points (found by sorting)."""
+    along = np.sort(mm.closest_points(points, curve).arc_lengths)
+    return np.diff(np.append(along, along[0] + mm.perimeter(curve))).max()
+
+
+def test_reseeding_keeps_a_budding_curve_sampled():
+    frames = [circle(120)] + [budding(t) for t in range(1, 5)]
+    spacing = np.linalg.norm(frames[0][1] - frames[0][0])
+    plain = mm.map_series(frames, "normal", reseed=None, progress=False)
+    kept = mm.map_series(frames, "normal", reseed=2.0, progress=False)
+    last = frames[-1]
+    without = largest_gap(plain.trajectories[-1], last)
+    with_reseeding = largest_gap(kept.trajectories[-1][np.isfinite(kept.trajectories[-1]).all(axis=1)], last)
+    print(f"largest spacing on the last frame: {without / spacing:.2f} x without re-seeding, "
+          f"{with_reseeding / spacing:.2f} x with (frame 0 spacing {spacing:.4f})")
+    assert without > 4 * spacing  # the buds' tips thin out
+    assert with_reseeding <= 2 * spacing * (1 + 1e-9)
+    # The points of frame 0 move exactly as without re-seeding; the new ones come after them.
+    assert np.array_equal(kept.trajectories[:, :120], plain.trajectories, equal_nan=True)
+    assert (kept.born[:120] == 0).all() and (kept.born[120:] >= 1).all() and np.all(np.diff(kept.born) >= 0)
+    assert len(np.unique(kept.born)) >= 3  # points born on at least two frames
+    for t in range(1, 5):
+        new = kept.born == t
+        if not new.any():
+            continue
+        assert np.isnan(kept.trajectories[:t, new]).all() and np.isfinite(kept.trajectories[t, new]).all()
+        assert mm.closest_points(kept.trajectories[t, new], frames[t]).distances.max() < 1e-12  # born on the frame
+    # The pieces of each frame run through all its points in order, once round.
+    chain = kept.cells[-1]
+    assert np.array_equal(chain[:, 1], np.roll(chain[:, 0], -1)) and len(np.unique(chain[:, 0])) == len(chain)
+    assert len(chain) == np.isfinite(kept.trajectories[-1]).all(axis=1).sum()
+    # Accumulated stretch passes to the parts of a split piece: lengths over it add up to frame 0's.
+    pieces = kept.cells[-2]
+    lengths = np.linalg.norm(kept.trajectories[-1][pieces[:, 1]] - kept.trajectories[-1][pieces[:, 0]], axis=1)
+    assert (lengths / kept.accumulated_stretch(-1)).sum() == pytest.approx(mm.perimeter(frames[0]), rel=1e-2)
+
+
+@pytest.mark.parametrize("clockwise", [False, True])
+def test_new_points_sit_between_their_neighbours(clockwise):
+    frames = [circle(60, r, clockwise=clockwise) for r in (1.0, 1.5, 2.5)]
+    series = mm.map_series(frames, "normal", progress=False)
+    assert (series.born[60:] == 2).all() and len(series.born) == 180  # 2.5 spacings: 2 new points a piece
+    points = series.trajectories[-1][series.cells[-1]]
+    angles = np.angle(np.exp(1j * np.diff(np.arctan2(points[..., 1], points[..., 0]), axis=1)))
+    assert np.allclose(np.abs(angles), 2 * np.pi / 180, rtol=2e-3)  # a third of an old piece (in arc length)
+    assert np.allclose(np.sign(angles), -1 if clockwise else 1)  # in the frames' own order
+
+
+def test_growth_maps_of_growing_circles_are_the_radius_ratios():
+    radii, dt = [1.0, 1.5, 2.5], 0.5
+    series = mm.map_series([circle(300, r) for r in radii], "normal", dt=dt, reseed=None, progress=False)
+    for k in range(2):
+        assert np.abs(series.stretch(k) - radii[k + 1] / radii[k]).max() < 1e-12
+        assert np.abs(series.accumulated_stretch(k) - radii[k + 1] / radii[0]).max() < 1e-12
+        assert np.abs(series.normal_speed[k] - (radii[k + 1] - radii[k]) / dt).max() < 1e-12
+        assert np.abs(series.accumulated_normal_speed[k] - (radii[k + 1] - radii[0]) / ((k + 1) * dt)).max() < 1e-12
+    # Shrinking: a negative normal speed.
+    back = mm.map_series([circle(300, r) for r in radii[::-1]], "normal", reseed=None, progress=False)
+    assert np.abs(back.normal_speed[0] + 1.0).max() < 1e-12 and np.abs(back.stretch(1) - 1.0 / 1.5).max() < 1e-12
+
+
+def test_growth_maps_of_growing_spheres():
+    # On the icosahedron every vertex normal is radial, so the normal mapping of a scaled copy
+    # lands on the scaled vertices and the closed forms hold to rounding; on a finer icosphere the
+    # vertex normals are a little off radial and the mapping, not the maps, leaves percent-level
+    # differences triangle by triangle.
+    radii, dt = [1.0, 1.3, 1.6], 2.0
+    for subdivisions, tolerance, mean_tolerance in ((0, 1e-12, 1e-12), (3, 3e-2, 1e-3)):
+        sphere = trimesh.creation.icosphere(subdivisions)
+        series = mm.map_series([sphere.copy().apply_scale(r) for r in radii], "normal", dt=dt, progress=False)
+        assert series.trajectories.shape[1] == len(sphere.vertices)  # no edge grew beyond twice its length
+        for k in range(2):
+            for got, want in ((series.stretch(k), (radii[k + 1] / radii[k]) ** 2),
+                              (series.accumulated_stretch(k), (radii[k + 1] / radii[0]) ** 2),
+                              (series.normal_speed[k], (radii[k + 1] - radii[k]) / dt),
+                              (series.accumulated_normal_speed[k], (radii[k + 1] - radii[0]) / ((k + 1) * dt))):
+                assert np.abs(got / want - 1).max() < tolerance and abs(got.mean() / want - 1) < mean_tolerance
+
+
+def test_reseeding_splits_the_grown_edges_of_a_surface():
+    sphere = trimesh.creation.icosphere(2)
+    tip = np.array([0.0, 0.0, 1.0])
+
+    def bud(height):  # a bump around the north pole growing out
+        v = sphere.vertices * (1 + height * np.exp(-np.sum((sphere.vertices - tip) ** 2, axis=1) / 0.3))[:, None]
+        return trimesh.Trimesh(v, sphere.faces, process=False)
+
+    frames = [bud(h) for h in (0.0, 0.6, 1.4)]
+    edges = sphere.vertices[sphere.edges_unique]
+    spacing = np.median(np.linalg.norm(edges[:, 1] - edges[:, 0], axis=1))
+    plain = mm.map_series(frames, "normal", reseed=None, progress=False)
+    kept = mm.map_series(frames, "normal", reseed=2.0, progress=False)
+
+    def longest_edge(series):
+        mesh = trimesh.Trimesh(series.trajectories[-1], series.cells[-1], process=False)
+        return mesh.edges_unique_length.max(), mesh
+
+    without, _ = longest_edge(plain)
+    with_reseeding, mesh = longest_edge(kept)
+    assert without > 2.5 * spacing and with_reseeding <= 2 * spacing
+    assert mesh.is_watertight and mesh.is_winding_consistent and mesh.volume > 0  # still closed and outward
+    new = kept.born > 0
+    assert new.sum() > 0 and np.isnan(kept.trajectories[0, new]).all()
+    assert np.array_equal(kept.trajectories[:, ~new], plain.trajectories, equal_nan=True)
+    for t in (1, 2):
+        born = kept.born == t
+        if born.any():
+            assert mm.SurfaceIndex(frames[t].vertices, frames[t].faces).closest_points(
+                kept.trajectories[t, born]).distances.max() < 1e-9
+    # The children of a split triangle inherit its accumulated stretch, so the areas of the last
+    # step's triangles divided by it add up to the area of frame 0 (up to the new points' moves
+    # onto the curved surface).
+    areas = trimesh.Trimesh(kept.trajectories[-1], kept.cells[-2], process=False).area_faces
+    assert (areas / kept.accumulated_stretch(-1)).sum() == pytest.approx(sphere.area, rel=1e-2)
+
+
+def test_bad_series_options_are_named():
+    frames = [circle(50), circle(50, 2.0)]
+    with pytest.raises(ValueError, match="reseed: the factor must be > 1"):
+        mm.map_series(frames, reseed=1.0)
+    with pytest.raises(ValueError, match="dt: must be"):
+        mm.map_series(frames, dt=0)
+    series = mm.map_series(frames, "normal", progress=False)
+    with pytest.raises(ValueError, match="step: expected 0..0"):
+        series.stretch(1)
+    with pytest.raises(TypeError, match="step: expected an integer"):
+        series.accumulated_stretch(0.5)
+
+
+def test_progress_bar_only_when_asked(capfd):
+    frames = [circle(50), circle(50, 2.0)]
+    mm.map_series(frames, "normal", progress=True)
+    assert "map_series" in capfd.readouterr().err
+    mm.map_series(frames, "normal", progress=False)
+    mm.map_series(frames, "normal")  # stderr is not a terminal here
+    assert "map_series" not in capfd.readouterr().err

@@ -156,7 +156,8 @@ def _series(args, parser) -> int:
         except (ValueError, TypeError) as error:
             parser.error(f"{path}: {error}")
     try:
-        series = morphomap.map_series(frames, args.method)
+        series = morphomap.map_series(frames, args.method, dt=args.dt, reseed=args.reseed,
+                                      progress=False if args.no_progress else None)
     except (ValueError, TypeError, morphomap.InvalidInput, morphomap.GeometryError) as error:
         parser.error(str(error))
     try:
@@ -199,7 +200,7 @@ def _batch(args, parser) -> int:
         from distributed import Client
 
         client = Client(args.scheduler)
-    results = map_batch(jobs, client=client, workers=args.workers)
+    results = map_batch(jobs, client=client, workers=args.workers, progress=False if args.no_progress else None)
     for r in results:
         print(f"{r.status:8s} {r.job.c1} -> {r.job.c2}: {r.message}", file=sys.stderr)
     failed = sum(r.status == "failed" for r in results)
@@ -293,11 +294,18 @@ def main(argv=None) -> int:
     series = commands.add_parser(
         "series", help="map every consecutive pair of a time series and follow the first frame's points",
         description="Map frame k onto frame k + 1 for every k (curves, surfaces, masks or stacks, all of one kind) "
-                    "and carry the points of the first frame through the fields; write the fields, the "
-                    "trajectories and the quality per step into --out.")
+                    "and carry the points of the first frame through the fields, with new points born where they "
+                    "spread apart; write the fields, the trajectories, the growth maps (stretch, normal speed), "
+                    "the quality per step, figures and an animation (GIF; MP4 when ffmpeg is there) into --out.")
     series.add_argument("frames", nargs="+", metavar="FRAME")
     _share(common, series, ("--spacing", "--label", "--smooth", "--edge-length", "--method"))
     series.add_argument("--out", required=True, metavar="DIR", help="the folder to write into")
+    series.add_argument("--dt", type=lambda text: _length(text, positive=True), default=1.0, metavar="DT",
+                        help="the time between two frames, for the normal speeds (default 1)")
+    series.add_argument("--reseed", type=_reseed, default=2.0, metavar="F",
+                        help="new points are born where neighbouring followed points get more than F times the "
+                             "first frame's spacing apart (default 2; 'none': follow only the first frame's points)")
+    series.add_argument("--no-progress", action="store_true", help="no progress bar (default: one on a terminal)")
     series.set_defaults(run=lambda args: _series(args, series))
     batch = commands.add_parser(
         "batch", help="map many pairs on Dask distributed (a local cluster, or --scheduler)",
@@ -310,6 +318,7 @@ def main(argv=None) -> int:
     batch.add_argument("--workers", type=_positive, default=None, metavar="N",
                        help="worker processes of the local cluster (default: one per core)")
     _share(common, batch, ("--spacing", "--smooth", "--method"))
+    batch.add_argument("--no-progress", action="store_true", help="no progress bar (default: one on a terminal)")
     batch.set_defaults(run=lambda args: _batch(args, batch))
     args = parser.parse_args(argv)
     try:
@@ -333,6 +342,15 @@ def _spacing(text: str) -> tuple:
     if len(values) not in (1, 2, 3):
         raise argparse.ArgumentTypeError(f"expected one length, or one per axis (rows,columns or sz,sy,sx), got {text!r}")
     return values
+
+
+def _reseed(text: str):
+    if text.lower() == "none":
+        return None
+    value = _length(text, positive=True)
+    if value <= 1:
+        raise argparse.ArgumentTypeError(f"expected a factor > 1 or 'none', got {value}")
+    return value
 
 
 def _positive(text: str) -> int:

@@ -36,40 +36,98 @@ class Series:
     fields : list of DisplacementField
         One per consecutive pair: ``fields[k]`` maps frame k onto frame k + 1.
     trajectories : (T, M, d) float
-        The points of frame 0 (its curve points or surface vertices) carried through every field
-        (``field.at``), NaN from the step where one is lost (its field has no vector there).
+        The material points followed through the frames (``field.at`` carries each from frame k
+        to frame k + 1): first the points of frame 0 (its curve points or surface vertices), then
+        the points born later where the followed points spread apart (see ``reseed`` in
+        :func:`map_series`), in the order they were born. A row is NaN before the point's birth and
+        from the step where it is lost (its field has no vector there).
+    born : (M,) int
+        The frame each point was born in (0 for the points of frame 0).
+    cells : list of T int arrays
+        The pieces of boundary between the followed points on each frame, after that frame's new
+        points: in 2D ``(P, 2)`` pairs of consecutive points along the curve (piece i runs from
+        ``cells[t][i, 0]`` to ``cells[t][i, 1]``); in 3D ``(F, 3)`` triangles, oriented outwards.
+    dt : float
+        The time between two frames.
+    normal_speed : (T - 1, M) float
+        Growth map, per step and point: ``(p(k+1) - p(k)) . n(k) / dt``, ``n(k)`` the unit outward
+        normal of the followed boundary at p(k) (2D: the normalised sum of the normals of the two
+        pieces meeting there, :func:`morphomap.normals`; 3D: the angle-weighted normal of the
+        triangles, :func:`morphomap.surface_normals`). NaN where the point is not alive at both
+        frames.
+    accumulated_normal_speed : (T - 1, M) float
+        Growth map from the point's birth to frame k + 1: the sum of its normal displacements over
+        those steps divided by the time elapsed.
     quality : list of StepQuality
         One row per step.
     """
 
-    def __init__(self, frames, fields, trajectories, quality):
+    def __init__(self, frames, fields, trajectories, quality, *, born=None, cells=None, stretches=None,
+                 accumulated=None, normal_speed=None, accumulated_normal_speed=None, dt=1.0):
         self.frames, self.fields, self.trajectories, self.quality = frames, fields, trajectories, quality
+        self.born = np.zeros(trajectories.shape[1], dtype=np.int64) if born is None else born
+        self.cells, self._stretches, self._accumulated = cells, stretches, accumulated
+        self.normal_speed, self.accumulated_normal_speed, self.dt = normal_speed, accumulated_normal_speed, dt
 
     @property
     def dim(self) -> int:
         return self.trajectories.shape[2]
 
+    def _step(self, step) -> int:
+        steps = len(self.fields)
+        if isinstance(step, (bool, np.bool_)) or not isinstance(step, (int, np.integer)):
+            raise TypeError(f"step: expected an integer, got {type(step).__name__}")
+        if not -steps <= step < steps:
+            raise ValueError(f"step: expected 0..{steps - 1} (or negative from the end), got {step}")
+        return int(step) % steps
+
     def stretch(self, step: int) -> np.ndarray:
-        """The local stretch of step ``step`` along the followed points: in 2D the length ratio of
-        each piece between consecutive trajectories (closed curve), L_i / l_i; in 3D the area
-        ratio of each triangle of frame 0's surface."""
-        before, after = self.trajectories[step], self.trajectories[step + 1]
-        if self.dim == 2:
-            def lengths(p):
-                return np.linalg.norm(np.roll(p, -1, axis=0) - p, axis=1)
+        """Growth map of step ``step``: the local stretch of each piece of ``cells[step]`` carried
+        to frame ``step + 1``, in 2D the length ratio L_i / l_i of the piece, in 3D the area ratio
+        of the triangle. NaN where a corner is lost."""
+        return self._stretches[self._step(step)].copy()
 
-            return lengths(after) / lengths(before)
-        faces = np.asarray(self.frames[0].faces)
+    def accumulated_stretch(self, step: int) -> np.ndarray:
+        """Growth map from frame 0 to frame ``step + 1``, on the pieces of ``cells[step]``: the
+        product of the stretches of the piece and of the pieces it was cut from (a piece that new
+        points split passes its accumulated stretch on to its parts). NaN where a point was lost."""
+        return self._accumulated[self._step(step)].copy()
 
-        def areas(p):
-            corners = p[faces]
-            return 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
+    def plot_trajectories(self, ax=None, **options):
+        """The followed points' paths coloured by time: :func:`morphomap.series_plot.plot_trajectories`."""
+        from .series_plot import plot_trajectories
 
-        return areas(after) / areas(before)
+        return plot_trajectories(self, ax, **options)
 
-    def write(self, folder) -> list:
-        """Write ``field_KK.csv`` per step, ``trajectories.csv`` (step, point, coordinates) and
-        ``quality.csv`` into ``folder`` (created); returns the paths. Writes are atomic."""
+    def plot_growth(self, quantity="accumulated_stretch", step=-1, ax=None, **options):
+        """A growth map as colour on the boundary: :func:`morphomap.series_plot.plot_growth`."""
+        from .series_plot import plot_growth
+
+        return plot_growth(self, quantity, step, ax, **options)
+
+    def animate(self, path, *, fps=2, dpi=90) -> None:
+        """Write an animation (``.gif``; ``.mp4`` when ffmpeg is installed) of the frames and the
+        followed points: :func:`morphomap.series_plot.animate`."""
+        from .series_plot import animate
+
+        animate(self, path, fps=fps, dpi=dpi)
+
+    def write(self, folder, *, figures=True) -> list:
+        """Write into ``folder`` (created) and return the paths:
+
+        - ``field_KK.csv`` per step;
+        - ``trajectories.csv`` (frame, point, coordinates; NaN before a point's birth and once lost)
+          and ``points.csv`` (point, the frame it was born in);
+        - ``quality.csv``, one row per step;
+        - ``stretch.csv`` (step, piece, its corner points, stretch, accumulated stretch) and
+          ``normal_speed.csv`` (step, point, normal speed, accumulated normal speed) with the
+          growth maps;
+        - with ``figures``: ``trajectories.png``, ``stretch.png`` and ``normal_speed.png`` (the
+          accumulated maps at the last frame), ``series.gif``, and ``series.mp4`` when ffmpeg is
+          installed.
+
+        Writes are atomic.
+        """
         from ._atomic import atomic_text
         from .io import write_field
 
@@ -95,12 +153,63 @@ class Series:
                 methods = " ".join(f"{k}:{v}" for k, v in q.methods.items())
                 handle.write(f"{q.step},{q.qm1!r},{q.qm2!r},{q.qm!r},{q.defects},{q.misses},{q.seconds:.3f},{methods}\n")
         paths.append(path)
+        path = os.path.join(folder, "points.csv")
+        with atomic_text(path) as handle:
+            handle.write("point,born\n")
+            handle.writelines(f"{i},{b}\n" for i, b in enumerate(self.born.tolist()))
+        paths.append(path)
+        path = os.path.join(folder, "stretch.csv")
+        corners = "a,b" if self.dim == 2 else "a,b,c"
+        with atomic_text(path) as handle:
+            handle.write(f"step,piece,{corners},stretch,accumulated_stretch\n")
+            for k in range(len(self.fields)):
+                for i, (cell, r, g) in enumerate(zip(self.cells[k].tolist(), self._stretches[k].tolist(),
+                                                     self._accumulated[k].tolist())):
+                    handle.write(f"{k},{i}," + ",".join(map(str, cell)) + f",{r!r},{g!r}\n")
+        paths.append(path)
+        path = os.path.join(folder, "normal_speed.csv")
+        with atomic_text(path) as handle:
+            handle.write("step,point,normal_speed,accumulated_normal_speed\n")
+            for k in range(len(self.fields)):
+                rows = np.flatnonzero(np.isfinite(self.normal_speed[k]) | np.isfinite(self.accumulated_normal_speed[k]))
+                for i, v, m in zip(rows.tolist(), self.normal_speed[k, rows].tolist(),
+                                   self.accumulated_normal_speed[k, rows].tolist()):
+                    handle.write(f"{k},{i},{v!r},{m!r}\n")
+        paths.append(path)
+        if figures:
+            paths.extend(self._write_figures(folder))
+        return paths
+
+    def _write_figures(self, folder) -> list:
+        import matplotlib.animation as animation
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+
+        from .plot import save_figure
+
+        paths = []
+        for name, draw in (("trajectories", lambda ax: self.plot_trajectories(ax)),
+                           ("stretch", lambda ax: self.plot_growth("accumulated_stretch", -1, ax)),
+                           ("normal_speed", lambda ax: self.plot_growth("accumulated_normal_speed", -1, ax))):
+            figure = Figure(figsize=(7, 6), layout="constrained")
+            FigureCanvasAgg(figure)
+            draw(figure.add_subplot(projection="3d" if self.dim == 3 else None))
+            path = os.path.join(folder, f"{name}.png")
+            save_figure(figure, path, dpi=100)
+            paths.append(path)
+        for suffix in ("gif", "mp4"):
+            if suffix == "mp4" and not animation.writers.is_available("ffmpeg"):
+                continue
+            path = os.path.join(folder, f"series.{suffix}")
+            self.animate(path)
+            paths.append(path)
         return paths
 
     def __repr__(self) -> str:
         lost = int(np.isnan(self.trajectories[-1]).any(axis=1).sum())
+        new = int((self.born > 0).sum())
         return (f"Series({len(self.frames)} frames in {self.dim}D, {len(self.fields)} fields, "
-                f"{self.trajectories.shape[1]} points followed, {lost} lost)")
+                f"{self.trajectories.shape[1]} points followed ({new} born after frame 0), {lost} lost)")
 
 
 def _progress(iterable, total, enabled, description):
@@ -113,7 +222,7 @@ def _progress(iterable, total, enabled, description):
     return tqdm(iterable, total=total, desc=description, unit="pair")
 
 
-def map_series(frames, method="auto", *, progress=None, **options) -> Series:
+def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **options) -> Series:
     """Map every consecutive pair of a time series and follow the points of the first frame.
 
     Parameters
@@ -121,6 +230,19 @@ def map_series(frames, method="auto", *, progress=None, **options) -> Series:
     frames : sequence of at least 2 curves ``(N, 2)`` or surfaces (``trimesh.Trimesh`` or
         ``(vertices, faces)``), all of one kind.
     method : the mapping algorithm for every pair (``"auto"`` by default).
+    dt : float
+        The time between two frames (for the normal speeds).
+    reseed : float or None
+        Keep the boundary sampled: on every frame after the first, where two neighbouring followed
+        points are more than ``reseed`` times the spacing of frame 0 apart (the median distance
+        between neighbouring points: consecutive curve points, or surface edges), new material
+        points are born on that frame's boundary between them, spaced at most the spacing of
+        frame 0 apart. 2D: the distance is the arc length along the frame between the two points'
+        closest points (the shorter way round), and the new points are equally spaced along that
+        arc. 3D: every triangle edge longer than the limit is split at its middle, moved onto the
+        frame's surface (the two triangles sharing it become four), until no edge is longer. New points are followed from
+        then on (their rows of ``trajectories`` are NaN before; ``born`` gives their frame).
+        ``None`` follows only the points of frame 0. Default 2.
     progress : bool, optional
         A progress bar (tqdm) on stderr; by default when stderr is a terminal.
     **options : passed to :func:`map_curves` (2D) or :func:`map_surfaces` (3D).
@@ -128,7 +250,10 @@ def map_series(frames, method="auto", *, progress=None, **options) -> Series:
     Returns
     -------
     Series
+        With the fields, trajectories, growth maps (``stretch``, ``accumulated_stretch``,
+        ``normal_speed``, ``accumulated_normal_speed``) and the quality per step.
     """
+    from ._validate import as_length
     from .mapping import map_curves
     from .quality import quality
     from .surfaces import as_surface, map_surfaces
@@ -139,13 +264,22 @@ def map_series(frames, method="auto", *, progress=None, **options) -> Series:
     curves = [isinstance(f, np.ndarray) and f.ndim == 2 and f.shape[1] == 2 for f in frames]
     if any(curves) and not all(curves):
         raise ValueError("frames: mix curves and surfaces; expected all of one kind")
+    dt = as_length(dt, "dt", 1.0)
+    if reseed is not None:
+        reseed = as_length(reseed, "reseed", 2.0)
+        if reseed <= 1:
+            raise ValueError(f"reseed: the factor must be > 1 (or None to switch re-seeding off), got {reseed}")
     if not curves[0]:
         import trimesh
 
         frames = [trimesh.Trimesh(*as_surface(f, f"frames[{k}]"), process=False) for k, f in enumerate(frames)]
-    first = frames[0] if curves[0] else np.asarray(frames[0].vertices)
-    trajectories = np.full((len(frames), len(first), first.shape[1]), np.nan)
-    trajectories[0] = first
+    closed = bool(options.get("closed", True)) if curves[0] else True
+    boundary = _CurveBoundary(frames, closed) if curves[0] else _SurfaceBoundary(frames)
+    positions = [boundary.first.copy()]  # per frame: every point born so far
+    born = np.zeros(len(boundary.first), dtype=np.int64)
+    cells, growth = [boundary.cells], [np.ones(len(boundary.cells))]
+    stretches, accumulated, speeds, mean_speeds = [], [], [], []
+    normal_distance = np.zeros(len(born))  # summed since each point's birth
     fields, table = [], []
     for k in _progress(range(len(frames) - 1), len(frames) - 1, progress, "map_series"):
         a, b = frames[k], frames[k + 1]
@@ -154,13 +288,125 @@ def map_series(frames, method="auto", *, progress=None, **options) -> Series:
             field = map_curves(a, b, method, **options) if curves[0] else map_surfaces(a, b, method, **options)
         except ValueError as error:
             raise ValueError(f"frames[{k}] -> frames[{k + 1}]: {error}") from None
-        q = quality(field, a, b)
+        q = quality(field, a, b, **({"closed": closed} if curves[0] else {}))
         seconds = time.perf_counter() - start
         names, counts = np.unique(field.method, return_counts=True)
         table.append(StepQuality(k, q.qm1, q.qm2, q.qm, q.crossings if curves[0] else q.folds,
                                  int((~field.valid).sum()), seconds, dict(zip(names.tolist(), counts.tolist()))))
         fields.append(field)
-        alive = np.isfinite(trajectories[k]).all(axis=1)
+        now = positions[k]
+        alive = np.isfinite(now).all(axis=1)
+        moved = np.full_like(now, np.nan)
         if alive.any():
-            trajectories[k + 1, alive] = trajectories[k, alive] + field.at(trajectories[k, alive])
-    return Series(frames, fields, trajectories, table)
+            moved[alive] = now[alive] + field.at(now[alive])
+        # Growth over the step, on the pieces and points of frame k.
+        ratio = boundary.measure(cells[k], moved) / boundary.measure(cells[k], now)
+        stretches.append(ratio)
+        accumulated.append(growth[k] * ratio)
+        normal_step = np.einsum("ij,ij->i", moved - now, boundary.normals(cells[k], now))
+        normal_distance = normal_distance + normal_step
+        speeds.append(normal_step / dt)
+        mean_speeds.append(normal_distance / ((k + 1 - born) * dt))
+        # Frame k + 1: the pieces without the points lost, then new points where they spread apart.
+        piece, piece_growth = boundary.without_lost(cells[k], accumulated[-1], np.isfinite(moved).all(axis=1))
+        if reseed is not None:
+            new, piece, piece_growth = boundary.reseed(moved, piece, piece_growth, k + 1, reseed)
+            moved = np.vstack([moved, new])
+            born = np.concatenate([born, np.full(len(new), k + 1)])
+            normal_distance = np.concatenate([normal_distance, np.zeros(len(new))])
+        positions.append(moved)
+        cells.append(boundary.as_cells(piece))
+        growth.append(piece_growth)
+    trajectories = np.full((len(frames), len(born), boundary.dim), np.nan)
+    for t, p in enumerate(positions):
+        trajectories[t, : len(p)] = p
+    speed_table = np.full((len(fields), len(born)), np.nan)
+    mean_table = np.full((len(fields), len(born)), np.nan)
+    for k, (v, m) in enumerate(zip(speeds, mean_speeds)):
+        speed_table[k, : len(v)], mean_table[k, : len(m)] = v, m
+    return Series(frames, fields, trajectories, table, born=born, cells=cells, stretches=stretches,
+                  accumulated=accumulated, normal_speed=speed_table, accumulated_normal_speed=mean_table, dt=dt)
+
+
+class _CurveBoundary:
+    """The followed points of a curve series: a chain of points in order along the curve."""
+
+    dim = 2
+
+    def __init__(self, frames, closed):
+        self.frames, self.closed = frames, closed
+        self.first = np.asarray(frames[0], dtype=float)
+        self.cells = self.as_cells(np.arange(len(self.first)))
+        self.spacing = float(np.median(self.measure(self.cells, self.first)))
+
+    def as_cells(self, chain):
+        after = np.roll(chain, -1) if self.closed else chain[1:]
+        return np.column_stack([chain[: len(after)], after])
+
+    def measure(self, cells, points):
+        return np.linalg.norm(points[cells[:, 1]] - points[cells[:, 0]], axis=1)
+
+    def normals(self, cells, points):
+        from .curves import normals
+
+        chain = cells[:, 0] if self.closed else np.append(cells[:, 0], cells[-1, 1])
+        result = np.full_like(points, np.nan)
+        if len(chain) >= (3 if self.closed else 2):
+            result[chain] = normals(points[chain], closed=self.closed)
+        return result
+
+    def without_lost(self, cells, growth, alive):
+        """The chain of the points still alive; a piece that spanned a lost point has an unknown
+        accumulated stretch (NaN)."""
+        chain = cells[:, 0] if self.closed else np.append(cells[:, 0], cells[-1, 1])
+        keep = alive[chain]
+        if keep.all():
+            return chain, growth
+        positions = np.flatnonzero(keep)
+        following = np.roll(positions, -1) if self.closed else positions[1:]
+        intact = (following - positions[: len(following)]) % len(chain) == 1
+        return chain[keep], np.where(intact, growth[positions[: len(following)]], np.nan)
+
+    def reseed(self, points, chain, growth, frame, factor):
+        from .reseed import reseed_curve
+
+        return reseed_curve(points, chain, growth, np.asarray(self.frames[frame], dtype=float), self.spacing,
+                            factor * self.spacing, self.closed)
+
+
+class _SurfaceBoundary:
+    """The followed points of a surface series: triangles over the points, split where they grow."""
+
+    dim = 3
+
+    def __init__(self, frames):
+        self.frames = frames
+        self.first = np.asarray(frames[0].vertices, dtype=float)
+        self.cells = np.asarray(frames[0].faces, dtype=np.int64)
+        corners = self.first[self.cells]
+        self.spacing = float(np.median(np.linalg.norm(corners[:, [1, 2, 0]] - corners, axis=2)))
+
+    def as_cells(self, faces):
+        return faces
+
+    def measure(self, cells, points):
+        corners = points[cells]
+        return 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
+
+    def normals(self, cells, points):
+        from .surfaces import surface_normals
+
+        return surface_normals(np.nan_to_num(points), cells)
+
+    def without_lost(self, cells, growth, alive):
+        """The triangles whose three corners are alive (where a point is lost the followed surface
+        has a hole)."""
+        keep = alive[cells].all(axis=1)
+        return cells[keep], growth[keep]
+
+    def reseed(self, points, faces, growth, frame, factor):
+        from .reseed import reseed_surface
+
+        surface = self.frames[frame]
+        return reseed_surface(points, faces, growth, (np.asarray(surface.vertices), np.asarray(surface.faces)),
+                              factor * self.spacing)

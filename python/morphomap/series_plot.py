@@ -1,0 +1,199 @@
+"""Pictures of a time series: trajectories coloured by time, growth maps, an animation."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._atomic import atomic_path
+from .plot import C1_COLOUR, _new_axes
+
+#: At most this many trajectories are drawn in 3D (evenly chosen): more only hide the surfaces.
+MAX_TRAJECTORIES_3D = 1500
+
+#: The growth maps :func:`plot_growth` draws.
+GROWTH_MAPS = ("stretch", "accumulated_stretch", "normal_speed", "accumulated_normal_speed")
+
+_LABELS = {
+    "stretch": "stretch over the step",
+    "accumulated_stretch": "stretch since frame 0",
+    "normal_speed": "normal speed",
+    "accumulated_normal_speed": "mean normal speed since birth",
+}
+
+
+def _check_axes(ax, dim):
+    if ax is None:
+        return _new_axes("3d" if dim == 3 else None)
+    if (dim == 3) != hasattr(ax, "plot_trisurf"):
+        wanted = "a 3D axes (projection='3d')" if dim == 3 else "a 2D axes"
+        raise TypeError(f"ax: expected {wanted} for a {dim}D series")
+    return ax
+
+
+def _frame_points(series, t):
+    frame = series.frames[t]
+    return np.asarray(frame if series.dim == 2 else frame.vertices, dtype=float)
+
+
+def _draw_frame(ax, series, t, colour, alpha, width=1.0):
+    if series.dim == 2:
+        points = _frame_points(series, t)
+        closed = np.vstack([points, points[:1]])
+        ax.plot(*closed.T, color=colour, alpha=alpha, lw=width)
+    else:
+        frame = series.frames[t]
+        ax.plot_trisurf(*np.asarray(frame.vertices).T, triangles=np.asarray(frame.faces), color=colour, alpha=alpha,
+                        linewidth=0)
+
+
+def _limits(ax, series, frames):
+    everything = np.vstack([_frame_points(series, t) for t in frames])
+    low, high = everything.min(axis=0), everything.max(axis=0)
+    centre, half = (low + high) / 2, 0.52 * (high - low).max()
+    if series.dim == 2:
+        ax.set_xlim(centre[0] - half, centre[0] + half)
+        ax.set_ylim(centre[1] - half, centre[1] + half)
+        ax.set_aspect("equal")
+    else:
+        ax.set(xlim=(centre[0] - half, centre[0] + half), ylim=(centre[1] - half, centre[1] + half),
+               zlim=(centre[2] - half, centre[2] + half), xlabel="x", ylabel="y", zlabel="z")
+        ax.set_box_aspect((1, 1, 1))
+
+
+def _trajectory_lines(ax, series, last, norm):
+    """The trajectories from frame 0 to frame ``last`` as one collection, each step's piece
+    coloured by the frame it ends on."""
+    from matplotlib.collections import LineCollection
+    from mpl_toolkits.mplot3d.art3d import Line3DCollection
+
+    points = np.arange(series.trajectories.shape[1])
+    if series.dim == 3 and len(points) > MAX_TRAJECTORIES_3D:
+        points = points[np.linspace(0, len(points) - 1, MAX_TRAJECTORIES_3D).astype(int)]
+    path = series.trajectories[: last + 1, points]
+    segments = np.stack([path[:-1], path[1:]], axis=2).reshape(-1, 2, series.dim)
+    times = np.repeat(np.arange(1, last + 1), len(points)).astype(float)
+    drawn = np.isfinite(segments).all(axis=(1, 2))
+    kind = Line3DCollection if series.dim == 3 else LineCollection
+    lines = kind(segments[drawn], cmap="plasma", norm=norm, linewidths=0.9)
+    lines.set_array(times[drawn])
+    if series.dim == 3:
+        ax.add_collection3d(lines)
+    else:
+        ax.add_collection(lines)
+    return lines
+
+
+def plot_trajectories(series, ax=None, *, title=None):
+    """Draw the followed points' paths over all frames, coloured by time; returns the ``Axes``.
+
+    Every frame's boundary is drawn thin and grey (3D: the first and last surfaces, translucent),
+    each point's path as line pieces from frame to frame, coloured by the frame the piece ends on
+    (a colour bar gives the frame); in 3D at most :data:`MAX_TRAJECTORIES_3D` paths, evenly chosen.
+    ``ax``: where to draw (a 3D axes for a 3D series), by default a new figure.
+    """
+    from matplotlib.colors import Normalize
+
+    ax = _check_axes(ax, series.dim)
+    last = len(series.frames) - 1
+    for t in range(len(series.frames)) if series.dim == 2 else (0, last):
+        _draw_frame(ax, series, t, "0.6", 0.7 if series.dim == 2 else 0.12, 0.6)
+    lines = _trajectory_lines(ax, series, last, Normalize(0, last))
+    ax.figure.colorbar(lines, ax=ax, shrink=0.7, label="frame")
+    _limits(ax, series, range(len(series.frames)))
+    ax.set_title(title if title is not None else f"trajectories of {series.trajectories.shape[1]} points")
+    return ax
+
+
+def growth_map(series, quantity, step):
+    """``(values, cells, points)``: the growth map ``quantity`` of step ``step`` as one value per
+    piece (2D) or triangle (3D) of ``series.cells[step]``, placed at the end of the step (point
+    values, the normal speeds, are averaged over each piece's corners)."""
+    if quantity not in GROWTH_MAPS:
+        raise ValueError(f"quantity: expected one of {', '.join(map(repr, GROWTH_MAPS))}, got {quantity!r}")
+    step = series._step(step)
+    cells = series.cells[step]
+    if quantity in ("stretch", "accumulated_stretch"):
+        values = getattr(series, quantity)(step)
+    else:
+        values = getattr(series, quantity)[step][cells].mean(axis=1)
+    return values, cells, series.trajectories[step + 1]
+
+
+def plot_growth(series, quantity="accumulated_stretch", step=-1, ax=None, *, title=None):
+    """Draw a growth map as colour on the boundary; returns the ``Axes``.
+
+    ``quantity``: one of :data:`GROWTH_MAPS`; ``step``: the step (default the last), drawn on the
+    followed boundary at its end, frame ``step + 1``: in 2D the pieces between the followed points
+    as coloured lines, in 3D the followed triangles coloured. A sequential colour map, or a diverging
+    one centred on 0 for normal speeds that change sign. Pieces with an unknown value
+    (a lost point) are left out. A colour bar gives the scale.
+    """
+    from matplotlib.collections import LineCollection
+    from matplotlib.colors import Normalize, TwoSlopeNorm
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    values, cells, points = growth_map(series, quantity, step)
+    ax = _check_axes(ax, series.dim)
+    shown = np.isfinite(values) & np.isfinite(points[cells]).all(axis=(1, 2))
+    values, cells = values[shown], cells[shown]
+    low, high = (float(values.min()), float(values.max())) if len(values) else (0.0, 1.0)
+    if high <= low:
+        low, high = low - 0.5 * abs(low or 1), high + 0.5 * abs(high or 1)
+    both_ways = quantity.endswith("normal_speed") and low < 0 < high  # growing here, shrinking there
+    norm = TwoSlopeNorm(0.0, low, high) if both_ways else Normalize(low, high)
+    cmap = "coolwarm" if both_ways else "viridis"
+    if series.dim == 2:
+        artist = LineCollection(points[cells], cmap=cmap, norm=norm, linewidths=3)
+        artist.set_array(values)
+        ax.add_collection(artist)
+    else:
+        artist = Poly3DCollection(points[cells], cmap=cmap, norm=norm, linewidths=0)
+        artist.set_array(values)
+        ax.add_collection3d(artist)
+    ax.figure.colorbar(artist, ax=ax, shrink=0.7, label=_LABELS[quantity])
+    step = series._step(step)
+    _limits(ax, series, (step, step + 1))
+    when = f"at frame {step + 1}" if quantity.startswith("accumulated") else f"frames {step} to {step + 1}"
+    ax.set_title(title if title is not None else f"{_LABELS[quantity]}, {when}")
+    return ax
+
+
+def animate(series, path, *, fps=2, dpi=90):
+    """Write an animation of the series to ``path``: ``.gif`` (Pillow) or ``.mp4`` (needs ffmpeg).
+
+    One picture per frame: that frame's boundary, the paths of the followed points so far coloured
+    by time and the points where they are. Fixed limits over all frames. Written atomically.
+    """
+    import matplotlib.animation as animation
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.colors import Normalize
+    from matplotlib.figure import Figure
+
+    name = str(path)
+    suffix = name.lower().rsplit(".", 1)[-1] if "." in name else ""
+    if suffix == "gif":
+        writer = animation.PillowWriter(fps=fps)
+    elif suffix == "mp4":
+        if not animation.writers.is_available("ffmpeg"):
+            raise ValueError(f"path: writing {name} needs ffmpeg, which is not installed; write a .gif instead")
+        writer = animation.FFMpegWriter(fps=fps)
+    else:
+        raise ValueError(f"path: expected a .gif or .mp4 file, got {name!r}")
+    figure = Figure(figsize=(6, 6))
+    FigureCanvasAgg(figure)
+    ax = figure.add_subplot(projection="3d" if series.dim == 3 else None)
+    last = len(series.frames) - 1
+    norm = Normalize(0, max(last, 1))
+    with atomic_path(name) as temporary:
+        with writer.saving(figure, temporary, dpi):
+            for t in range(len(series.frames)):
+                ax.clear()
+                _draw_frame(ax, series, t, C1_COLOUR, 1.0 if series.dim == 2 else 0.25, 1.6)
+                if t:
+                    _trajectory_lines(ax, series, t, norm)
+                now = series.trajectories[t]
+                now = now[np.isfinite(now).all(axis=1)]
+                ax.scatter(*now.T, s=3 if series.dim == 2 else 1, color="black")
+                _limits(ax, series, range(len(series.frames)))
+                ax.set_title(f"frame {t} of {last}: {len(now)} points")
+                writer.grab_frame()
