@@ -9,7 +9,7 @@ import trimesh
 
 import morphomap as mm
 from morphomap import best
-from morphomap.best import Candidate, candidate_table
+from morphomap.best import candidate_table
 
 import frames  # noqa: E402  (next to this file)
 
@@ -131,4 +131,8 @@ def test_bad_input():
     with pytest.raises(ValueError, match="candidates"):
         candidate_table(mm.map_curves(c1, c2, "normal"))
     assert mm.map_curves(c1, c2, "normal").candidates is None
-    assert isinstance(Candidate("x", 1.0, 1.0, 1.0, 0, 0, 0.0, "admissible"), tuple)
+    # Options that only some candidates take are refused up front, not dropped with a candidate.
+    with pytest.raises(ValueError, match="stretch_weight"):
+        mm.map_curves(c1, c2, "best", stretch_weight=-1.0)
+    with pytest.raises(ValueError, match="density_threshold"):
+        mm.map_curves(c1, c2, "best", density_threshold=0.0)

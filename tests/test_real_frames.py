@@ -230,6 +230,16 @@ def test_surfaces_sharing_faces_map_with_diffusion_and_the_shared_patch_stays(re
         assert np.asarray(field.starts)[np.argmax(ends[:, 0]), 0] > 28.0
 
 
+def test_bodies_that_only_touch_from_outside_are_refused_by_diffusion():
+    """Two boxes sharing a face: the surfaces meet, so they count as crossing until the contact is
+    cleared, after which they lie apart; diffusion says so instead of meshing two bodies."""
+    left = trimesh.creation.box(bounds=[[0, 0, 0], [1, 1, 1]])
+    right = trimesh.creation.box(bounds=[[1, 0, 0], [2, 1, 1]])
+    with pytest.raises(ValueError, match="s2: only touches s1 from outside"):
+        mm.map_surfaces(left, right, "diffusion")
+    assert mm.map_surfaces(left, right, "auto").valid.all()
+
+
 def test_ctrl_c_stops_a_long_mapping_within_a_second(tmp_path):
     if os.name != "posix":
         pytest.skip("signals")

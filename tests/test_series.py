@@ -95,6 +95,23 @@ def test_reseeding_keeps_a_budding_curve_sampled():
 
 
 @pytest.mark.parametrize("clockwise", [False, True])
+def test_reseeding_two_points_fills_both_arcs(clockwise):
+    """A chain of two live points has one piece a quarter round and one three quarters round: each
+    is filled along its own arc (the shorter way for both would fill the quarter twice)."""
+    from morphomap.reseed import reseed_curve
+
+    frame = circle(400, clockwise=clockwise)
+    points = np.array([[1.0, 0.0], [0.0, -1.0 if clockwise else 1.0]])
+    new, chain, _ = reseed_curve(points, np.array([0, 1]), np.ones(2), frame, 0.1, 0.2, True)
+    assert len(new) == int(np.ceil(np.pi / 2 / 0.1)) - 1 + int(np.ceil(1.5 * np.pi / 0.1)) - 1
+    everything = np.vstack([points, new])[chain]
+    assert largest_gap(everything, frame) <= 0.1 * (1 + 1e-6)
+    # In chain order the points go once round the frame.
+    angles = np.unwrap(np.arctan2(everything[:, 1], everything[:, 0]))
+    assert abs(abs(angles[-1] - angles[0]) - 2 * np.pi) < 0.2
+
+
+@pytest.mark.parametrize("clockwise", [False, True])
 def test_new_points_sit_between_their_neighbours(clockwise):
     frames = [circle(60, r, clockwise=clockwise) for r in (1.0, 1.5, 2.5)]
     series = mm.map_series(frames, "normal", progress=False)

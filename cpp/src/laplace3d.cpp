@@ -379,6 +379,11 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
                                                   target_index, finer_edge, nesting);
   const detail::ClearedSource& cleared = cleared_pair.source;
   nesting = cleared_pair.nesting;
+  // Bodies that only touch from outside count as crossing until the contact is cleared.
+  if (nesting == detail::Nesting::disjoint) {
+    throw InvalidInput("s2: only touches s1 from outside (the surfaces neither cross nor enclose one another); "
+                       "diffusion mapping needs surfaces that overlap");
+  }
   // From here on the source is the cleared one: it bounds the region that is meshed and solved.
   const Points3& source_region = cleared.vertices;
   std::unique_ptr<detail::CrossingRegion> crossing;

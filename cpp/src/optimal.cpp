@@ -130,12 +130,17 @@ bool solve_level(const Problem& p, const Level& level, std::vector<Index>& path,
     const double prev_s = first ? 0.0 : p.s[level.rows[r - 1]];
     const Index plo = first ? 0 : level.lo[r - 1], phi = first ? 0 : level.hi[r - 1];
     const double dl = p.s[i] - prev_s;
+    // A long source edge (curves are not resampled by default) may take as long a target arc.
+    const Index row_reach =
+        p.source_length > 0.0
+            ? std::max(reach, static_cast<Index>(std::ceil(8.0 * static_cast<double>(samples) * dl / p.source_length)) + 2)
+            : reach;
     for (Index k = lo; k <= hi; ++k) {
       const double displacement = p.displacement_weight * (pi - q[k]).squaredNorm();
       double best = kInf;
       Index arg = -1;
       const bool pinned = first && p.pinned_first;
-      const Index from = std::max(plo, pinned ? k : k - reach), to = std::min(phi, pinned ? k : k - 1);
+      const Index from = std::max(plo, pinned ? k : k - row_reach), to = std::min(phi, pinned ? k : k - 1);
       for (Index kp = from; kp <= to; ++kp) {
         const double before = first ? 0.0 : cost[r - 1][kp - plo];
         if (before == kInf) continue;

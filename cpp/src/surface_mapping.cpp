@@ -71,11 +71,15 @@ DisplacementField3 basic(MapMethod method, const Surface& source, const Surface&
         own_index = std::make_unique<SurfaceIndex>(source.vertices, source.faces);
         source_index = own_index.get();
       }
+      const Points3 placed = field.ends;
       detail::unfold(field.starts, field.ends, field.faces, source.vertices, source.faces, *source_index,
                      target.vertices, target.faces, target_index);
+      // Touching vertices went to their closest point, unless the repair has moved them since.
       field.methods.assign(field.size(), Method::diffusion);
       for (Index i = 0; i < field.size(); ++i) {
-        if (solution.touching[static_cast<std::size_t>(i)]) field.methods[i] = Method::minimal_distance;
+        if (solution.touching[static_cast<std::size_t>(i)] && field.ends.row(i) == placed.row(i)) {
+          field.methods[i] = Method::minimal_distance;
+        }
       }
       break;
     }

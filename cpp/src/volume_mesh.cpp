@@ -115,12 +115,18 @@ void split_chords(VolumeMesh& mesh) {
   // then the other (the orientation stays); a chord another split has cut is left.
   std::vector<Eigen::Matrix<Index, 1, 4>> tets;
   for (Index t = 0; t < mesh.tetrahedra.rows(); ++t) tets.push_back(mesh.tetrahedra.row(t));
+  // The tetrahedra around each vertex, so that a chord's are found without a scan of the mesh;
+  // an entry may be stale (a split took the vertex out of that tetrahedron): checked on use.
+  std::vector<std::vector<std::size_t>> around(static_cast<std::size_t>(n) + chords.size());
+  for (std::size_t t = 0; t < tets.size(); ++t) {
+    for (int i = 0; i < 4; ++i) around[static_cast<std::size_t>(tets[t](i))].push_back(t);
+  }
   std::vector<Eigen::RowVector3d> added;
   for (const auto& [a, b] : chords) {
     const Index m = n + static_cast<Index>(added.size());
     bool split = false;
-    const std::size_t count = tets.size();
-    for (std::size_t t = 0; t < count; ++t) {
+    const std::vector<std::size_t> candidates = around[static_cast<std::size_t>(a)];
+    for (const std::size_t t : candidates) {
       int ia = -1, ib = -1;
       for (int i = 0; i < 4; ++i) {
         if (tets[t](i) == a) ia = i;
@@ -131,6 +137,9 @@ void split_chords(VolumeMesh& mesh) {
       tets[t](ib) = m;
       other(ia) = m;
       tets.push_back(other);
+      const std::size_t u = tets.size() - 1;
+      around[static_cast<std::size_t>(m)].push_back(t);
+      for (int i = 0; i < 4; ++i) around[static_cast<std::size_t>(other(i))].push_back(u);
       split = true;
     }
     if (split) added.push_back(0.5 * (mesh.vertices.row(a) + mesh.vertices.row(b)));

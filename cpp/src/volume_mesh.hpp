@@ -12,9 +12,10 @@ struct VolumeMesh {
 
 // The surface: closed, manifold, free of self-intersections (else InvalidInput naming
 // `name`). Edges and surface triangles about `size` long; `seed` fixes Mesh_3's random choices
-// (the same seed, the same mesh). Every tetrahedron has a corner off the surface (a tetrahedron
-// with four corners on it has its longest chord split at the midpoint). Runs in a child process (mesh_in_child.hpp): a crash of CGAL
-// becomes a GeometryError. Throws GeometryError if Mesh_3 gives no tetrahedra.
+// (the same seed, the same mesh). A tetrahedron with four corners on the surface has its longest
+// edge through the inside (chord) split at the midpoint, so that it gets a free node; one whose six
+// edges all lie on the surface (possible only where the surface folds sharply) is left whole.
+// Runs in a child process (mesh_in_child.hpp): a crash of CGAL becomes a GeometryError. Throws GeometryError if Mesh_3 gives no tetrahedra.
 VolumeMesh mesh_volume(const Points3Ref& vertices, const FacesRef& faces, double size, int seed, const char* name);
 
 }  // namespace morphomap::detail

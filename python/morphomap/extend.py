@@ -94,8 +94,8 @@ def extend_field(field, boundary=None, *, method="harmonic", mesh=None, mesh_siz
         without a mesh: the domain is meshed with CGAL's constrained Delaunay mesher, every
         point of C1 a node. 3D without a mesh: the region S1 (the field's start triangles, a
         closed surface) encloses is meshed with CGAL's Mesh_3, its surface nodes on S1's
-        triangles, every tetrahedron with a node inside (one with four corners on S1 would move
-        with the boundary field alone); the mesher's random choices are fixed, so the same field
+        triangles, and a tetrahedron with four corners on S1 (which would move with the boundary
+        field alone) split to get a node inside, unless all six of its edges lie on S1; the mesher's random choices are fixed, so the same field
         gives the same mesh.
     mesh_size : float, optional
         Without a mesh, 2D: the largest edge (default: graded from C1's point spacing); 3D: the

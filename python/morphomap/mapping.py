@@ -123,6 +123,16 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
         if as_flag(reverse, "reverse") or as_flag(transform, "transform"):
             raise ValueError("reverse/transform: method 'best' tries the reversed and transformed forms itself; "
                              "leave both False")
+        # Checked here, as a candidate that refuses an option would only drop out of the choice.
+        _threshold(density_threshold)
+        as_length(stretch_weight, "stretch_weight", _core.DEFAULT_STRETCH_WEIGHT, allow_zero=True)
+        as_length(contact_tolerance, "contact_tolerance", -1.0, allow_zero=True)
+        as_length(mesh_size, "mesh_size", 0.0)
+        as_length(mesh_fraction, "mesh_fraction", 0.02)
+        if n is not None:
+            as_count(n, "n", 3 if closed else 2)
+        if anchor is not None:
+            as_point(anchor, "anchor")
         return map_best(c1, c2, closed=closed, n=n, split=split, anchor=anchor,
                         density_threshold=density_threshold, contact_tolerance=contact_tolerance,
                         mesh_size=mesh_size, mesh_fraction=mesh_fraction, stretch_weight=stretch_weight,

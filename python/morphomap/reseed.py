@@ -42,13 +42,21 @@ def reseed_curve(points, chain, growth, frame, spacing, limit, closed):
     total = perimeter(frame, closed=closed)
     start = along[:pieces]
     end = np.roll(along, -1)[:pieces] if closed else along[1:]
-    # Each piece runs the shorter way round between its two points (on an open curve, the only
-    # way): whichever way the frame runs, and robust to two neighbours that swapped places.
-    arc = np.mod(end - start, total) if closed else np.abs(end - start)
-    way = np.ones(pieces) if closed else np.sign(end - start)
+    # On an open curve a piece runs the only way between its points. Round a closed frame the
+    # chain runs one way (the way whose arcs add up to less: once round), whichever way the frame
+    # runs; a piece whose arc that way is more than half round, in a chain that then goes round
+    # more than once, is two neighbours that swapped places: it runs the shorter way back.
     if closed:
-        back = arc > total / 2
-        arc[back], way[back] = total - arc[back], -1.0
+        forward = np.mod(end - start, total)
+        backward = np.mod(total - forward, total)
+        direction = 1.0 if forward.sum() <= backward.sum() else -1.0
+        arc = forward if direction > 0 else backward
+        way = np.full(pieces, direction)
+        if arc.sum() > 1.5 * total:
+            back = arc > total / 2
+            arc[back], way[back] = total - arc[back], -direction
+    else:
+        arc, way = np.abs(end - start), np.sign(end - start)
     counts = np.where(arc > limit, np.ceil(arc / spacing).astype(np.int64) - 1, 0)
     if not counts.any():
         return np.empty((0, 2)), chain, growth

@@ -346,10 +346,16 @@ class _CurveBoundary:
     def measure(self, cells, points):
         return np.linalg.norm(points[cells[:, 1]] - points[cells[:, 0]], axis=1)
 
+    def chain(self, cells):
+        """The points in order along the followed curve (none when no piece is left)."""
+        if self.closed or len(cells) == 0:
+            return cells[:, 0]
+        return np.append(cells[:, 0], cells[-1, 1])
+
     def normals(self, cells, points):
         from .curves import normals
 
-        chain = cells[:, 0] if self.closed else np.append(cells[:, 0], cells[-1, 1])
+        chain = self.chain(cells)
         result = np.full_like(points, np.nan)
         if len(chain) >= (3 if self.closed else 2):
             result[chain] = normals(points[chain], closed=self.closed)
@@ -358,7 +364,7 @@ class _CurveBoundary:
     def without_lost(self, cells, growth, alive):
         """The chain of the points still alive; a piece that spanned a lost point has an unknown
         accumulated stretch (NaN)."""
-        chain = cells[:, 0] if self.closed else np.append(cells[:, 0], cells[-1, 1])
+        chain = self.chain(cells)
         keep = alive[chain]
         if keep.all():
             return chain, growth

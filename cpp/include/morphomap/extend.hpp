@@ -49,8 +49,9 @@ struct ExtendOptions {
 // 2D, mesh_cells empty: the region C1 encloses is meshed with CGAL's constrained Delaunay mesher,
 // every point of C1 a node, edges at most mesh_size (<= 0: graded from C1's point spacing).
 // 3D, mesh_cells empty: the region the start triangles enclose (a closed surface) is meshed with
-// CGAL's Mesh_3 (its surface nodes lie on the triangles; no tetrahedron has all four corners on
-// them, so that none moves with the boundary field alone).
+// CGAL's Mesh_3 (its surface nodes lie on the triangles; a tetrahedron with all four corners on
+// them, which would move with the boundary field alone, gets a node inside by a split of its
+// longest inner edge, unless all six of its edges lie on the surface).
 // Throws InvalidInput naming "source", "mesh", "field", "poisson_ratio", "substeps" or
 // "mesh_size" (e.g. a boundary node without a displacement, where the field missed).
 InteriorField2 extend_field(const DisplacementField2& field, const Points2Ref& source, const Points2Ref& mesh_points,
