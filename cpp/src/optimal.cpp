@@ -126,7 +126,6 @@ bool solve_level(const Problem& p, const Level& level, std::vector<Index>& path,
     back[r].assign(hi - lo + 1, -1);
     // The previous vector: the virtual one at the start of the pieces, or row r - 1.
     const bool first = r == 0;
-    const Vec2 prev_point = first ? p.begin_source : Vec2(p.starts.row(level.rows[r - 1]).transpose());
     const double prev_s = first ? 0.0 : p.s[level.rows[r - 1]];
     const Index plo = first ? 0 : level.lo[r - 1], phi = first ? 0 : level.hi[r - 1];
     const double dl = p.s[i] - prev_s;
