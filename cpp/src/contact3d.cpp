@@ -179,9 +179,10 @@ ClearedSource clear_contact(const Points3Ref& source_vertices, const FacesRef& s
       refuse(touching_faces, tolerance, "where they also cross");
     }
     // Away from the target, on the patch's side: along the source normals, turned to agree with
-    // the way from the target's surface into that side. The surfaces face the same way along the patch (nested frames) or opposite ways (bodies that
-    // touch from outside): decided once per patch, as a vertex at a crease of the target may see
-    // the normal of a face that does not represent it.
+    // the way from the target's surface into that side. The surfaces face the same way along the
+    // patch (nested frames) or opposite ways (bodies that touch from outside): decided once per
+    // patch, as a vertex at a crease of the target may see the normal of a face that does not
+    // represent it.
     double agreement = 0.0;
     for (const Index v : patch) {
       const Index face = hits.faces[v];

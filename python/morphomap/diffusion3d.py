@@ -67,8 +67,9 @@ def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False) -> ShellDif
         vertices of S1 within 1% of the finer mean edge of S2 map to their closest point there
         (``touching``), and those within half that edge are pulled back from S2 along S1's normals,
         to half an edge away on the side their surroundings lie, before the region is meshed
-        (their streamlines start there). Surfaces that lie apart, or a contact patch that also
-        crosses S2 or that the pull-back would fold into itself, raise ValueError;
+        (their streamlines start there). Surfaces that lie apart or only touch from outside, or
+        a contact patch that also crosses S2 or that the pull-back would fold into itself, raise
+        ValueError;
         ``map_surfaces(..., method="auto")`` falls back to normal mapping there.
     mesh_size : float, optional
         Largest tetrahedron size. Default: a quarter of the mean gap (the region's volume over the

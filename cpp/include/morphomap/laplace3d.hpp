@@ -45,8 +45,8 @@ struct ShellDiffusionSolution {
 // are pulled back from the target along the source's normals, to half an edge away on the side
 // their surroundings lie, before the region is meshed; their streamlines start from there. Such
 // a patch whose surroundings lie on both sides of the target (the surfaces also cross there), or
-// that the pull-back would fold into itself: InvalidInput. Surfaces that lie apart or intersect
-// themselves: InvalidInput. Mesh_3 runs in a child process where fork exists
+// that the pull-back would fold into itself: InvalidInput. Surfaces that lie apart, only touch
+// from outside, or intersect themselves: InvalidInput. Mesh_3 runs in a child process where fork exists
 // (it can crash on valid input); a crash there is retried twice with other random choices and
 // slightly finer sizes, then a GeometryError. Streamlines start on the
 // mesh boundary at the closest point to each source vertex and follow the recovered, linearly
