@@ -190,8 +190,8 @@ class PeerTracer:
 
     def direction(self, x, t):
         """Unit direction of the interpolated flow at points x in triangles t (all found)."""
-        l = self._barycentric(x, t)
-        u = np.einsum("ni,nij->nj", l, self.flow[self.triangles[t]])
+        weights = self._barycentric(x, t)
+        u = np.einsum("ni,nij->nj", weights, self.flow[self.triangles[t]])
         return u / np.hypot(*u.T)[:, None]
 
     def potential(self, x, t):

@@ -10,7 +10,7 @@ assembling the P1 Laplacian on the same mesh and solving the Dirichlet problem f
 components with scipy's spsolve (SuperLU), the boundary values taken from morphomap's answer so
 that both solve the same problem; the answers are compared. Best of 3, one process.
 
-speed3d: the lung-like pair (morphomap.data.make_lung), auto mapping, the harmonic extension on
+speed3d: the lung-like pair (morphomap.synthetic.lung), auto mapping, the harmonic extension on
 morphomap's Mesh_3 meshes of S1's inside at three sizes; the peer: scikit-fem on the same
 tetrahedra, each component solved with pyamg (smoothed aggregation, CG, relative residual 1e-10)
 and with spsolve.
@@ -87,7 +87,7 @@ def speed():
 
 
 def speed3d():
-    from morphomap.data.make_lung import lung_pair
+    from morphomap.synthetic.lung import lung_pair
 
     field = mm.map_surfaces(*lung_pair(), "auto")
     print("| nodes | tetrahedra | mesh s | morphomap s | pyamg s | ratio | spsolve s | ratio | max difference |")
@@ -117,7 +117,7 @@ def inversion_row(label, field, mesh, variants):
 
 
 def inversions():
-    from morphomap.data.make_lung import lung_pair
+    from morphomap.synthetic.lung import lung_pair
 
     variants = [{}, {"substeps": 4}, {"substeps": 16}, {"method": "elastic"}, {"method": "elastic", "substeps": 16}]
     print("| pair, field, mesh size | cells | harmonic | 4 substeps | 16 substeps | elastic | elastic, 16 substeps |")

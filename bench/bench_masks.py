@@ -114,7 +114,10 @@ def main():
         pipeline, shape, faces = args.one
         one(pipeline, parse_shape(shape), int(faces))
         return
-    print("| stack (z x y x x) | pipeline | s per frame | peak GB | faces | min angle | 1% angle | watertight | QM1 normal |")
+    print(
+        "| stack (z x y x x) | pipeline | s per frame | peak GB | faces | min angle | 1% angle | watertight "
+        "| QM1 normal |"
+    )
     print("|---|---|---:|---:|---:|---:|---:|---|---:|")
     for text in args.sizes:
         shape = parse_shape(text)
@@ -122,10 +125,15 @@ def main():
         peer = child("peer", shape, ours["faces"])
         for name, r in (("morphomap", ours), ("skimage + trimesh", peer)):
             qm1 = f"{r['qm1']:.4g}" if isinstance(r["qm1"], float) else r["qm1"]
-            print(f"| {'x'.join(map(str, shape))} | {name} | {r['seconds']:.2f} | {r['max_rss_gb']:.2f} | {r['faces']} | "
-                  f"{r['min_angle']:.1f} | {r['p1_angle']:.1f} | {r['watertight']} | {qm1} |")
-        print(f"| | peer / morphomap | {peer['seconds'] / ours['seconds']:.2f} | {peer['max_rss_gb'] / ours['max_rss_gb']:.2f} | | "
-              f"{peer['min_angle'] / max(ours['min_angle'], 1e-9):.3f} | | | |")
+            print(
+                f"| {'x'.join(map(str, shape))} | {name} | {r['seconds']:.2f} | {r['max_rss_gb']:.2f} | {r['faces']} | "
+                f"{r['min_angle']:.1f} | {r['p1_angle']:.1f} | {r['watertight']} | {qm1} |"
+            )
+        print(
+            f"| | peer / morphomap | {peer['seconds'] / ours['seconds']:.2f} "
+            f"| {peer['max_rss_gb'] / ours['max_rss_gb']:.2f} | | "
+            f"{peer['min_angle'] / max(ours['min_angle'], 1e-9):.3f} | | | |"
+        )
 
 
 if __name__ == "__main__":

@@ -36,7 +36,9 @@ def uv_ellipsoid(rings: int, segments: int):
     theta = np.pi * np.arange(1, rings) / rings
     phi = 2 * np.pi * np.arange(segments) / segments
     t, p = np.meshgrid(theta, phi, indexing="ij")
-    ring = np.column_stack([np.sin(t).ravel() * np.cos(p).ravel(), np.sin(t).ravel() * np.sin(p).ravel(), np.cos(t).ravel()])
+    ring = np.column_stack(
+        [np.sin(t).ravel() * np.cos(p).ravel(), np.sin(t).ravel() * np.sin(p).ravel(), np.cos(t).ravel()]
+    )
     v = np.vstack([[0, 0, 1], ring, [0, 0, -1]]) * AXES
     s, south = segments, len(v) - 1
     faces = []
@@ -197,7 +199,12 @@ CLOSEST_TOOLS = (
     Tool("morphomap", "morphomap", _mm_build, _mm_closest),
     Tool("open3d", "open3d", _o3d_build, _o3d_closest),
     Tool("libigl", "igl", lambda v, f: (v, f), _igl_closest),
-    Tool("point-cloud-utils", "point_cloud_utils", lambda v, f: (v, np.ascontiguousarray(f, dtype=np.int32)), _pcu_closest),
+    Tool(
+        "point-cloud-utils",
+        "point_cloud_utils",
+        lambda v, f: (v, np.ascontiguousarray(f, dtype=np.int32)),
+        _pcu_closest,
+    ),
 )
 
 

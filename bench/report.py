@@ -91,7 +91,9 @@ def main() -> None:
     parser.add_argument("--curves", type=int, nargs="+", default=list(cp.CURVE_SIZES))
     parser.add_argument("--queries", type=int, nargs="+", default=list(cp.QUERY_SIZES))
     parser.add_argument("--kernels", nargs="+", default=list(cp.KERNELS), choices=cp.KERNELS)
-    parser.add_argument("--wait", type=float, default=900.0, help="seconds to wait, before each size, for other load to end")
+    parser.add_argument(
+        "--wait", type=float, default=900.0, help="seconds to wait, before each size, for other load to end"
+    )
     args = parser.parse_args()
 
     import morphomap as mm
@@ -131,28 +133,49 @@ def main() -> None:
                     if tool.name == "morphomap":
                         reference = result
                     else:
-                        checks.append(f"{kernel} n={n} q={q} {tool.name}: {cp.check(kernel, tool.name, reference, result)}")
+                        checks.append(
+                            f"{kernel} n={n} q={q} {tool.name}: {cp.check(kernel, tool.name, reference, result)}"
+                        )
                     del prepared, result
                 mine = throughput["morphomap"]
                 peers = [v for t in tools if t.equal_work and t.name != "morphomap" and (v := throughput[t.name])]
-                rows.append([kernel, f"{n:,}", f"{q:,}", *(rate(throughput[t.name]) for t in tools),
-                             ratio(mine, max(peers, default=None)), ratio(mine, throughput.get("shapely"))])
+                rows.append(
+                    [
+                        kernel,
+                        f"{n:,}",
+                        f"{q:,}",
+                        *(rate(throughput[t.name]) for t in tools),
+                        ratio(mine, max(peers, default=None)),
+                        ratio(mine, throughput.get("shapely")),
+                    ]
+                )
                 print(f"done: {kernel} n={n} q={q}", file=sys.stderr, flush=True)
-        header = ["kernel", "curve vertices", "queries",
-                  *(f"{t.name} (q/s)" + ("" if t.equal_work else " [lower bound]") for t in tools),
-                  "morphomap / fastest peer", "morphomap / shapely"]
+        header = [
+            "kernel",
+            "curve vertices",
+            "queries",
+            *(f"{t.name} (q/s)" + ("" if t.equal_work else " [lower bound]") for t in tools),
+            "morphomap / fastest peer",
+            "morphomap / shapely",
+        ]
         tables.append((header, rows))
 
-    print(f"morphomap {info.get('version')} with {info.get('threads', '?')} threads; "
-          f"best of {args.repeat}; throughput in queries per second (k = 10^3, M = 10^6).")
+    print(
+        f"morphomap {info.get('version')} with {info.get('threads', '?')} threads; "
+        f"best of {args.repeat}; throughput in queries per second (k = 10^3, M = 10^6)."
+    )
     print("Threads: " + ", ".join(sorted({f"{t.name} {t.threads}" for t in cp.TOOLS if t.available()})) + ".")
     if loaded:
         print("WARNING, taken while other processes kept the cores busy: " + ", ".join(loaded) + ".")
     if skipped:
         print("Not installed, left out: " + ", ".join(skipped) + ".")
-    print("Shapely is left out (—) above "
-          + "; ".join(f"{k}: {cp.SHAPELY_MAX_CURVE[k]:,} vertices or {cp.SHAPELY_MAX_WORK[k]:,} queries"
-                      for k in cp.KERNELS) + ".\n")
+    print(
+        "Shapely is left out (—) above "
+        + "; ".join(
+            f"{k}: {cp.SHAPELY_MAX_CURVE[k]:,} vertices or {cp.SHAPELY_MAX_WORK[k]:,} queries" for k in cp.KERNELS
+        )
+        + ".\n"
+    )
     for header, rows in tables:
         print("| " + " | ".join(header) + " |")
         print("|" + "|".join("---" if i < 1 else "---:" for i in range(len(header))) + "|")
@@ -164,7 +187,9 @@ def main() -> None:
     print("| curve vertices | " + " | ".join(names) + " |")
     print("|---:|" + "---:|" * len(names))
     for n in args.curves:
-        print(f"| {n:,} | " + " | ".join(f"{builds[(m, n)] * 1e3:.1f}" if (m, n) in builds else "—" for m in names) + " |")
+        print(
+            f"| {n:,} | " + " | ".join(f"{builds[(m, n)] * 1e3:.1f}" if (m, n) in builds else "—" for m in names) + " |"
+        )
     print("\nAgreement with morphomap (not timed):\n")
     for line in checks:
         print(f"- {line}")

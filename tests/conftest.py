@@ -1,5 +1,9 @@
 """Shapes with closed-form geometry, shared by the tests."""
 
+import os
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -41,3 +45,13 @@ def require_client(available: bool, what: str) -> None:
     if os.environ.get("CI", "").lower() == "true":
         pytest.fail(f"{what} is missing, and CI must run this test (.ci/run installs it)")
     pytest.skip(f"{what} is not installed")
+
+
+def morphomap(*args, cwd=None):
+    """Runs the `morphomap` command with the package as imported here (also from another folder)."""
+    import morphomap as mm
+
+    where = os.path.dirname(os.path.dirname(os.path.abspath(mm.__file__)))
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [where, os.environ.get("PYTHONPATH")])))
+    return subprocess.run([sys.executable, "-m", "morphomap", *map(str, args)], capture_output=True, text=True,
+                          cwd=cwd, env=env)

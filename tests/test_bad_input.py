@@ -24,7 +24,9 @@ CALLS = {
     "closest_points_queries": lambda x: mm.closest_points(x, SQUARE),
     "closest_points_curve": lambda x: mm.closest_points(SQUARE, x),
     "line_intersections_origins": lambda x: mm.line_intersections(x, np.ones_like(np.asarray(x, dtype=float)), SQUARE),
-    "line_intersections_directions": lambda x: mm.line_intersections(np.zeros_like(np.asarray(x, dtype=float)), x, SQUARE),
+    "line_intersections_directions": lambda x: mm.line_intersections(
+        np.zeros_like(np.asarray(x, dtype=float)), x, SQUARE
+    ),
     "line_intersections_curve": lambda x: mm.line_intersections(SQUARE, SQUARE, x, closed=False),
     "curve_intersections_c1": lambda x: mm.curve_intersections(x, SQUARE),
     "curve_intersections_c2": lambda x: mm.curve_intersections(SQUARE + 0.5, x, closed=False),
@@ -58,8 +60,19 @@ def test_random_arrays_never_crash(name, value):
         CALLS[name](value)
     except (ValueError, TypeError) as error:
         assert str(error).split(":")[0] in {
-            "points", "n", "queries", "curve", "origins", "directions", "c1", "c2", "starts", "ends",
-            "a", "b", "field",
+            "points",
+            "n",
+            "queries",
+            "curve",
+            "origins",
+            "directions",
+            "c1",
+            "c2",
+            "starts",
+            "ends",
+            "a",
+            "b",
+            "field",
         }, str(error)
 
 

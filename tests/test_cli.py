@@ -1,9 +1,14 @@
-"""The command line."""
+"""The command line: `morphomap info`, `map`, `extend`, `series` and `batch` end to end."""
 
+import re
 import subprocess
 import sys
 
+import numpy as np
+import pytest
+
 import morphomap as mm
+from conftest import morphomap
 
 
 def test_info_prints_versions_and_threads():
@@ -15,31 +20,73 @@ def test_info_prints_versions_and_threads():
     assert info["threads"] >= 1 and f"threads   {info['threads']}" in out
 
 
-def test_kernels_release_the_gil():
-    """While one thread runs a long query, another Python thread keeps running."""
-    import threading
+def test_map_round_trip(tmp_path):
+    c1, c2 = mm.load_example("kidney")
+    mm.write_curve(tmp_path / "c1.csv", c1)
+    mm.write_curve(tmp_path / "c2.csv", c2, header=False)
+    run = morphomap("map", tmp_path / "c1.csv", tmp_path / "c2.csv", "--method", "normal", "--reverse",
+                    "-o", tmp_path / "field.csv", "--plot", tmp_path / "field.png")
+    assert run.returncode == 0, run.stderr
+    expected = mm.map_curves(c1, c2, "normal", reverse=True)
+    field = mm.read_field(tmp_path / "field.csv")
+    assert np.array_equal(field.starts, expected.starts, equal_nan=True)
+    assert np.array_equal(field.ends, expected.ends, equal_nan=True)
+    assert (tmp_path / "field.png").stat().st_size > 10_000
+    assert f"{len(expected)} vectors" in run.stderr and "QM1" in run.stderr
 
-    import numpy as np
 
-    from conftest import circle
+def test_map_options_reach_map_curves(tmp_path):
+    x = np.linspace(0, 1, 30)
+    mm.write_curve(tmp_path / "a.csv", np.column_stack([x, np.zeros(30)]))
+    mm.write_curve(tmp_path / "b.csv", np.column_stack([3 * x, 1 + x**2]))
+    run = morphomap("map", tmp_path / "a.csv", tmp_path / "b.csv", "--method", "uniform", "--open",
+                    "--n", 12, "--no-split", "--transform")
+    assert run.returncode == 0, run.stderr
+    lines = run.stdout.splitlines()  # no -o: the field goes to standard output
+    assert lines[0] == "start_x,start_y,end_x,end_y,valid,method" and len(lines) == 13
+    a, b = mm.read_curve(tmp_path / "a.csv"), mm.read_curve(tmp_path / "b.csv")
+    expected = mm.map_curves(a, b, "uniform", closed=False, n=12, split=False, transform=True)
+    got = np.array([[float(v) for v in line.split(",")[:4]] for line in lines[1:]])
+    assert np.allclose(got, np.hstack([expected.starts, expected.ends]), rtol=0, atol=1e-15)
 
-    index = mm.CurveIndex(circle(20000))
-    queries = np.random.default_rng(1).uniform(-2, 2, size=(2_000_000, 2))
-    started = threading.Event()
 
-    def work():
-        started.set()
-        index.closest_points(queries)
+def test_map_with_the_default_method(tmp_path):
+    c1, c2 = mm.load_example("kidney")
+    mm.write_curve(tmp_path / "c1.csv", c1)
+    mm.write_curve(tmp_path / "c2.csv", c2)
+    run = morphomap("map", tmp_path / "c1.csv", tmp_path / "c2.csv", "-o", tmp_path / "f.csv")
+    assert run.returncode == 0, run.stderr
+    field = mm.read_field(tmp_path / "f.csv")
+    assert set(field.method) == {"normal", "reverse_diffusion"}
+    assert mm.count_crossings(field.starts, field.ends) == 0
 
-    worker = threading.Thread(target=work)
-    worker.start()
-    started.wait()
-    spins = 0
-    while worker.is_alive():
-        spins += 1
-    worker.join()
-    # Holding the GIL, the kernel would leave this thread a handful of switch intervals at most.
-    assert spins > 1000
+
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        (None, "cannot read .*missing.csv: No such file"),
+        ("x,y,z\n1,2\n", "expected 3 values like the header"),
+        ("1,2,3\n", "line 1: expected 2 values"),
+        ("x,y\n1,2\n1,two\n2,2\n", "line 3, column y: 'two' is not a number"),
+        ("x,y\n0,0\n1,0\n2,0\n", "cannot map .* encloses zero area"),
+    ],
+)
+def test_map_bad_files_exit_2_with_a_message(tmp_path, content, message):
+    c1, _ = mm.load_example("circle_ellipse")
+    mm.write_curve(tmp_path / "good.csv", c1)
+    if content is not None:
+        (tmp_path / "missing.csv").write_text(content)
+    run = morphomap("map", tmp_path / "missing.csv", tmp_path / "good.csv", "--method", "normal")
+    assert run.returncode == 2
+    assert "Traceback" not in run.stderr
+    assert run.stderr.startswith("usage: morphomap map")
+    assert re.search(message, run.stderr), run.stderr
+
+
+def test_map_bad_arguments_exit_2(tmp_path):
+    for args in (["--method", "closest"], ["--n", "1"], ["--open", "--closed"]):
+        run = morphomap("map", "a.csv", "b.csv", *args, cwd=tmp_path)
+        assert run.returncode == 2 and "Traceback" not in run.stderr, args
 
 
 def test_map_reads_masks(tmp_path):
@@ -70,8 +117,11 @@ def test_map_reads_masks(tmp_path):
     assert done.returncode == 2 and "spacing: expected one number or one per axis (rows, columns)" in done.stderr
     # A stack and a mask are not two of a kind.
     np.save(tmp_path / "stack.npy", np.ones((3, 4, 4), np.uint8))
-    done = subprocess.run([sys.executable, "-m", "morphomap", "map", str(tmp_path / "stack.npy"), str(tmp_path / "t1.tif")],
-                          capture_output=True, text=True)
+    done = subprocess.run(
+        [sys.executable, "-m", "morphomap", "map", str(tmp_path / "stack.npy"), str(tmp_path / "t1.tif")],
+        capture_output=True,
+        text=True,
+    )
     assert done.returncode == 2 and "is a surface but" in done.stderr and "is a curve" in done.stderr
 
 
@@ -83,16 +133,25 @@ def test_map_reads_stacks_and_mesh_files(tmp_path):
     import tifffile
 
     z, y, x = np.indices((20, 60, 60))
+
     def ball(radius):
         return ((x - 30) * 0.5) ** 2 + ((y - 30) * 0.5) ** 2 + ((z - 10) * 2.0) ** 2 <= radius**2
 
-    tifffile.imwrite(tmp_path / "t0.tif", ball(8.0).astype(np.uint8), imagej=True, resolution=(2.0, 2.0),
-                     metadata={"spacing": 2.0, "unit": "um", "axes": "ZYX"})
+    tifffile.imwrite(
+        tmp_path / "t0.tif",
+        ball(8.0).astype(np.uint8),
+        imagej=True,
+        resolution=(2.0, 2.0),
+        metadata={"spacing": 2.0, "unit": "um", "axes": "ZYX"},
+    )
     np.save(tmp_path / "t1.npy", ball(11.0))
     out, plot = tmp_path / "field.csv", tmp_path / "field.png"
     command = [sys.executable, "-m", "morphomap", "map", str(tmp_path / "t0.tif"), str(tmp_path / "t1.npy")]
-    done = subprocess.run([*command, "--spacing", "2,0.5,0.5", "--method", "normal", "-o", str(out), "--plot", str(plot)],
-                          capture_output=True, text=True)
+    done = subprocess.run(
+        [*command, "--spacing", "2,0.5,0.5", "--method", "normal", "-o", str(out), "--plot", str(plot)],
+        capture_output=True,
+        text=True,
+    )
     assert done.returncode == 0, done.stderr
     assert "voxel spacing 2 x 0.5 x 0.5 (--spacing)" in done.stderr and "folds 0" in done.stderr
     field = mm.read_field(out)
@@ -104,8 +163,22 @@ def test_map_reads_stacks_and_mesh_files(tmp_path):
     assert mm.quality(field, s0, s1).folds == 0
     assert plot.stat().st_size > 10_000
     mm.write_surface(tmp_path / "t1.ply", s1)
-    done = subprocess.run([sys.executable, "-m", "morphomap", "map", str(tmp_path / "t0.tif"), str(tmp_path / "t1.ply"),
-                           "--method", "normal", "-o", str(out)], capture_output=True, text=True)
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "morphomap",
+            "map",
+            str(tmp_path / "t0.tif"),
+            str(tmp_path / "t1.ply"),
+            "--method",
+            "normal",
+            "-o",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert done.returncode == 0, done.stderr
     assert "voxel spacing 2 x 0.5 x 0.5 (the file)" in done.stderr
     # Curve options are refused for surfaces, and uniform is a 2D method.
@@ -125,27 +198,48 @@ def test_extend_writes_the_interior_displacement(tmp_path):
     mm.write_curve(tmp_path / "c1.csv", c1)
     mm.write_curve(tmp_path / "c2.csv", c2)
     command = [sys.executable, "-m", "morphomap", "extend", str(tmp_path / "c1.csv"), str(tmp_path / "c2.csv")]
-    done = subprocess.run([*command, "--method", "diffusion", "--dt", "2", "-o", str(tmp_path / "u.vtu")],
-                          capture_output=True, text=True)
+    done = subprocess.run(
+        [*command, "--method", "diffusion", "--dt", "2", "-o", str(tmp_path / "u.vtu")], capture_output=True, text=True
+    )
     assert done.returncode == 0, done.stderr
     assert "InteriorField(" in done.stderr and "written to" in done.stderr
     made = meshio.read(tmp_path / "u.vtu")
     assert {"displacement", "velocity"} <= set(made.point_data)
     solver = mm.extend_field(mm.map_curves(c1, c2, "diffusion"), mesh_size=0.1)
     meshio.write(tmp_path / "solver.xdmf", meshio.Mesh(solver.points, [("triangle", solver.cells)]))
-    done = subprocess.run([*command, "--method", "diffusion", "--mesh", str(tmp_path / "solver.xdmf"),
-                           "-o", str(tmp_path / "u.txt")], capture_output=True, text=True)
+    done = subprocess.run(
+        [*command, "--method", "diffusion", "--mesh", str(tmp_path / "solver.xdmf"), "-o", str(tmp_path / "u.txt")],
+        capture_output=True,
+        text=True,
+    )
     assert done.returncode == 0, done.stderr
     table = np.loadtxt(tmp_path / "u.txt", comments="%")
     assert np.allclose(table[:, :2], solver.points) and np.allclose(table[:, 2:], solver.displacement)
-    done = subprocess.run([*command, "--method", "diffusion", "--mesh", str(tmp_path / "solver.xdmf"), "--extension",
-                           "elastic", "--substeps", "2", "-o", str(tmp_path / "e.txt")], capture_output=True, text=True)
+    done = subprocess.run(
+        [
+            *command,
+            "--method",
+            "diffusion",
+            "--mesh",
+            str(tmp_path / "solver.xdmf"),
+            "--extension",
+            "elastic",
+            "--substeps",
+            "2",
+            "-o",
+            str(tmp_path / "e.txt"),
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert done.returncode == 0, done.stderr
-    elastic = mm.extend_field(mm.map_curves(c1, c2, "diffusion"), mesh=(solver.points, solver.cells),
-                              method="elastic", substeps=2)
+    elastic = mm.extend_field(
+        mm.map_curves(c1, c2, "diffusion"), mesh=(solver.points, solver.cells), method="elastic", substeps=2
+    )
     assert np.allclose(np.loadtxt(tmp_path / "e.txt", comments="%")[:, 2:], elastic.displacement)
-    done = subprocess.run([*command, "--mesh", str(tmp_path / "u.txt"), "-o", str(tmp_path / "v.vtu")],
-                          capture_output=True, text=True)
+    done = subprocess.run(
+        [*command, "--mesh", str(tmp_path / "u.txt"), "-o", str(tmp_path / "v.vtu")], capture_output=True, text=True
+    )
     assert done.returncode == 2 and "cannot read the mesh" in done.stderr
 
 
@@ -158,15 +252,37 @@ def test_series_and_batch_commands(tmp_path):
     for k in range(3):
         paths.append(tmp_path / f"t{k}.csv")
         mm.write_curve(paths[-1], circle(120, 1.0 + 0.3 * k))
-    done = subprocess.run([sys.executable, "-m", "morphomap", "series", *map(str, paths), "--method", "normal",
-                           "--out", str(tmp_path / "series")], capture_output=True, text=True)
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "morphomap",
+            "series",
+            *map(str, paths),
+            "--method",
+            "normal",
+            "--out",
+            str(tmp_path / "series"),
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert done.returncode == 0, done.stderr
     assert "step 1:" in done.stderr and "3 frames in 2D" in done.stderr
     table = np.loadtxt(tmp_path / "series" / "trajectories.csv", delimiter=",", skiprows=1)
     assert np.allclose(np.linalg.norm(table[table[:, 0] == 2][:, 2:], axis=1), 1.6)
     (tmp_path / "jobs.csv").write_text("c1,c2\nt0.csv,t1.csv\nt1.csv,t2.csv,diffusion\nt0.csv,missing.csv\n")
-    command = [sys.executable, "-m", "morphomap", "batch", str(tmp_path / "jobs.csv"), "--out", str(tmp_path / "b"),
-               "--workers", "2"]
+    command = [
+        sys.executable,
+        "-m",
+        "morphomap",
+        "batch",
+        str(tmp_path / "jobs.csv"),
+        "--out",
+        str(tmp_path / "b"),
+        "--workers",
+        "2",
+    ]
     done = subprocess.run(command, capture_output=True, text=True)
     assert done.returncode == 1 and "3 jobs: 2 done or skipped, 1 failed" in done.stderr, done.stderr
     assert mm.read_field(tmp_path / "b" / "002_t1_t2.csv").method[0] == "diffusion"
@@ -182,8 +298,24 @@ def test_series_command_writes_growth_maps_figures_and_animation(tmp_path):
     for k, radius in enumerate((1.0, 1.5, 2.5)):
         paths.append(tmp_path / f"t{k}.csv")
         mm.write_curve(paths[-1], circle(60, radius))
-    done = subprocess.run([sys.executable, "-m", "morphomap", "series", *map(str, paths), "--method", "normal",
-                           "--dt", "0.5", "--no-progress", "--out", str(tmp_path / "s")], capture_output=True, text=True)
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "morphomap",
+            "series",
+            *map(str, paths),
+            "--method",
+            "normal",
+            "--dt",
+            "0.5",
+            "--no-progress",
+            "--out",
+            str(tmp_path / "s"),
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert done.returncode == 0, done.stderr
     out = tmp_path / "s"
     born = np.loadtxt(out / "points.csv", delimiter=",", skiprows=1)
@@ -196,6 +328,9 @@ def test_series_command_writes_growth_maps_figures_and_animation(tmp_path):
         assert Image.open(out / name).format == "PNG"
     with Image.open(out / "series.gif") as gif:
         assert gif.n_frames == 3
-    bad = subprocess.run([sys.executable, "-m", "morphomap", "series", *map(str, paths), "--reseed", "1",
-                          "--out", str(out)], capture_output=True, text=True)
+    bad = subprocess.run(
+        [sys.executable, "-m", "morphomap", "series", *map(str, paths), "--reseed", "1", "--out", str(out)],
+        capture_output=True,
+        text=True,
+    )
     assert bad.returncode == 2 and "expected a factor > 1 or 'none'" in bad.stderr

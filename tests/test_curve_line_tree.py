@@ -1,6 +1,6 @@
 """CurveIndex.line_intersections through its float32 line tree equals an exhaustive double scan.
 
-The reference repeats the per-segment test of cpp/src/curve_index.cpp (`visit`: the crossing test
+The reference repeats the per-segment test of cpp/src/curves/curve_index.cpp (`visit`: the crossing test
 with its 1e-12 slack at segment ends, segments lying on the line, ties to the positive side and
 then the lower segment) over every segment, so the answers must be identical, not just close:
 any box the float tree culls wrongly shows up as a different hit.

@@ -1,26 +1,13 @@
-"""`morphomap demo` and `morphomap map` end to end."""
+"""`morphomap demo` end to end."""
 
-import os
-import re
-import subprocess
-import sys
-
-import numpy as np
 import pytest
 
 pytest.importorskip("matplotlib")
 
 import morphomap as mm  # noqa: E402
-from morphomap import demo  # noqa: E402
+from morphomap.cli import demo  # noqa: E402
 from morphomap.io import EXAMPLES  # noqa: E402
-
-
-def morphomap(*args, cwd=None):
-    # The package as imported here, also when running from another folder.
-    where = os.path.dirname(os.path.dirname(os.path.abspath(mm.__file__)))
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [where, os.environ.get("PYTHONPATH")])))
-    return subprocess.run([sys.executable, "-m", "morphomap", *map(str, args)], capture_output=True, text=True,
-                          cwd=cwd, env=env)
+from conftest import morphomap  # noqa: E402
 
 
 def test_demo_runs_every_algorithm_and_writes_everything(tmp_path):
@@ -91,72 +78,3 @@ def test_demo_default_folder_and_failures(monkeypatch):
     assert cli.main(["demo"]) == 0 and calls == ["morphomap-demo"]
     monkeypatch.setattr(demo, "run", lambda out: [demo.Row("p", "normal", "plain", note="failed: ValueError: x")])
     assert cli.main(["demo", "--out", "elsewhere"]) == 1
-
-
-def test_map_round_trip(tmp_path):
-    c1, c2 = mm.load_example("kidney")
-    mm.write_curve(tmp_path / "c1.csv", c1)
-    mm.write_curve(tmp_path / "c2.csv", c2, header=False)
-    run = morphomap("map", tmp_path / "c1.csv", tmp_path / "c2.csv", "--method", "normal", "--reverse",
-                    "-o", tmp_path / "field.csv", "--plot", tmp_path / "field.png")
-    assert run.returncode == 0, run.stderr
-    expected = mm.map_curves(c1, c2, "normal", reverse=True)
-    field = mm.read_field(tmp_path / "field.csv")
-    assert np.array_equal(field.starts, expected.starts, equal_nan=True)
-    assert np.array_equal(field.ends, expected.ends, equal_nan=True)
-    assert (tmp_path / "field.png").stat().st_size > 10_000
-    assert f"{len(expected)} vectors" in run.stderr and "QM1" in run.stderr
-
-
-def test_map_options_reach_map_curves(tmp_path):
-    x = np.linspace(0, 1, 30)
-    mm.write_curve(tmp_path / "a.csv", np.column_stack([x, np.zeros(30)]))
-    mm.write_curve(tmp_path / "b.csv", np.column_stack([3 * x, 1 + x**2]))
-    run = morphomap("map", tmp_path / "a.csv", tmp_path / "b.csv", "--method", "uniform", "--open",
-                    "--n", 12, "--no-split", "--transform")
-    assert run.returncode == 0, run.stderr
-    lines = run.stdout.splitlines()  # no -o: the field goes to standard output
-    assert lines[0] == "start_x,start_y,end_x,end_y,valid,method" and len(lines) == 13
-    a, b = mm.read_curve(tmp_path / "a.csv"), mm.read_curve(tmp_path / "b.csv")
-    expected = mm.map_curves(a, b, "uniform", closed=False, n=12, split=False, transform=True)
-    got = np.array([[float(v) for v in line.split(",")[:4]] for line in lines[1:]])
-    assert np.allclose(got, np.hstack([expected.starts, expected.ends]), rtol=0, atol=1e-15)
-
-
-def test_map_with_the_default_method(tmp_path):
-    c1, c2 = mm.load_example("kidney")
-    mm.write_curve(tmp_path / "c1.csv", c1)
-    mm.write_curve(tmp_path / "c2.csv", c2)
-    run = morphomap("map", tmp_path / "c1.csv", tmp_path / "c2.csv", "-o", tmp_path / "f.csv")
-    assert run.returncode == 0, run.stderr
-    field = mm.read_field(tmp_path / "f.csv")
-    assert set(field.method) == {"normal", "reverse_diffusion"}
-    assert mm.count_crossings(field.starts, field.ends) == 0
-
-
-@pytest.mark.parametrize(
-    ("content", "message"),
-    [
-        (None, "cannot read .*missing.csv: No such file"),
-        ("x,y,z\n1,2\n", "expected 3 values like the header"),
-        ("1,2,3\n", "line 1: expected 2 values"),
-        ("x,y\n1,2\n1,two\n2,2\n", "line 3, column y: 'two' is not a number"),
-        ("x,y\n0,0\n1,0\n2,0\n", "cannot map .* encloses zero area"),
-    ],
-)
-def test_map_bad_files_exit_2_with_a_message(tmp_path, content, message):
-    c1, _ = mm.load_example("circle_ellipse")
-    mm.write_curve(tmp_path / "good.csv", c1)
-    if content is not None:
-        (tmp_path / "missing.csv").write_text(content)
-    run = morphomap("map", tmp_path / "missing.csv", tmp_path / "good.csv", "--method", "normal")
-    assert run.returncode == 2
-    assert "Traceback" not in run.stderr
-    assert run.stderr.startswith("usage: morphomap map")
-    assert re.search(message, run.stderr), run.stderr
-
-
-def test_map_bad_arguments_exit_2(tmp_path):
-    for args in (["--method", "closest"], ["--n", "1"], ["--open", "--closed"]):
-        run = morphomap("map", "a.csv", "b.csv", *args, cwd=tmp_path)
-        assert run.returncode == 2 and "Traceback" not in run.stderr, args

@@ -97,7 +97,7 @@ def test_affine_boundary_maps_extend_to_the_same_map_on_the_default_3d_mesh(opti
 def test_every_tetrahedron_of_the_default_3d_mesh_has_a_free_node():
     # Tetrahedra with four corners on S1 would move with the boundary field alone: their longest
     # chord is split. The lung-like S1 (tubes, a crotch) has many such caps under Mesh_3.
-    from morphomap.data.make_lung import lung_pair
+    from morphomap.synthetic.lung import lung_pair
 
     s1, _ = lung_pair()
     field = mm.DisplacementField(s1.vertices, s1.vertices @ A3.T + B3, "normal", faces=s1.faces)

@@ -393,7 +393,8 @@ def classify(records):
     for record in records:
         outcome = record["outcome"]
         if outcome == "crash":
-            failures["crash"].append((record, f"{record['signal']} in phase {record.get('phase')}: {record['message']}"))
+            why = f"{record['signal']} in phase {record.get('phase')}: {record['message']}"
+            failures["crash"].append((record, why))
             continue
         if outcome == "timeout":
             failures["hang"].append((record, record["message"]))
@@ -416,17 +417,36 @@ def classify(records):
             continue
         # outcome "ok"
         if record.get("far_ends"):
-            failures["ends_off_target"].append((record, (
-                f"{record['far_ends']} of {record['valid']} ends farther than {record['end_tolerance']:.2e} "
-                f"from the target, up to {record['max_end_distance']:.3e}")))
+            failures["ends_off_target"].append(
+                (
+                    record,
+                    (
+                        f"{record['far_ends']} of {record['valid']} ends farther than {record['end_tolerance']:.2e} "
+                        f"from the target, up to {record['max_end_distance']:.3e}"
+                    ),
+                )
+            )
         if record.get("far_starts"):
-            failures["starts_off_source"].append((record, (
-                f"{record['far_starts']} of {record['valid']} starts farther than {record['start_tolerance']:.2e} "
-                f"from the source, up to {record['max_start_distance']:.3e}")))
+            failures["starts_off_source"].append(
+                (
+                    record,
+                    (
+                        f"{record['far_starts']} of {record['valid']} starts farther than "
+                        f"{record['start_tolerance']:.2e} "
+                        f"from the source, up to {record['max_start_distance']:.3e}"
+                    ),
+                )
+            )
         if record.get("out_of_order"):
-            failures["out_of_order"].append((record, (
-                f"{record['out_of_order']} ends out of order along C2 ({record['valid']} valid vectors, "
-                f"{record.get('chord_crossings')} crossing pairs)")))
+            failures["out_of_order"].append(
+                (
+                    record,
+                    (
+                        f"{record['out_of_order']} ends out of order along C2 ({record['valid']} valid vectors, "
+                        f"{record.get('chord_crossings')} crossing pairs)"
+                    ),
+                )
+            )
         if record.get("folds"):
             failures["folds"].append((record, f"{record['folds']} folds ({record['valid']} valid vectors)"))
         if record.get("check_error"):
@@ -436,20 +456,27 @@ def classify(records):
 
 def _describe(record):
     info = record.get("info") or {}
-    shape = ", ".join(f"{k}={info[k]}" for k in ("style", "raw", "kind", "smoothing", "n1", "n2", "vertices")
-                      if info.get(k) not in (None, []))
+    shape = ", ".join(
+        f"{k}={info[k]}"
+        for k in ("style", "raw", "kind", "smoothing", "n1", "n2", "vertices")
+        if info.get(k) not in (None, [])
+    )
     return f"seed {record['seed']} {record['method']}/{record['variant']} [{shape}]"
 
 
 def summary(run):
     """Counts of outcomes, of the allowed errors by message, and the time, as text."""
     records = run["records"]
-    lines = [f"{run['dim']}D: {len(run['fixed']) + len(run['fresh'])} pairs ({len(run['fixed'])} fixed seeds, "
-             f"fresh seeds {run['fresh']}), {len(records)} cases in {run['seconds']:.0f} s"]
+    lines = [
+        f"{run['dim']}D: {len(run['fixed']) + len(run['fresh'])} pairs ({len(run['fixed'])} fixed seeds, "
+        f"fresh seeds {run['fresh']}), {len(records)} cases in {run['seconds']:.0f} s"
+    ]
     builds = collections.Counter(r.get("build") for r in records if r.get("build"))
     if len(builds) > 1:
-        lines.append("WARNING: the library was reinstalled during the run; cases per build: " + "; ".join(
-            f"{build}: {count}" for build, count in builds.items()))
+        lines.append(
+            "WARNING: the library was reinstalled during the run; cases per build: "
+            + "; ".join(f"{build}: {count}" for build, count in builds.items())
+        )
     elif builds:
         lines.append(f"library: {next(iter(builds))}")
     outcomes = collections.Counter(r["outcome"] for r in records)
@@ -462,12 +489,19 @@ def summary(run):
     if errors:
         lines.append("errors (style, type, message: count):")
         lines += [f"  {style:7s} {kind}: {text}: {count}" for (style, kind, text), count in errors.most_common(25)]
-    missing = [r for r in records if r["outcome"] == "ok" and r["method"] in ("diffusion", "auto")
-               and r.get("valid", 0) < r.get("vectors", 0)]
+    missing = [
+        r
+        for r in records
+        if r["outcome"] == "ok" and r["method"] in ("diffusion", "auto") and r.get("valid", 0) < r.get("vectors", 0)
+    ]
     if missing:
-        lines.append(f"diffusion/auto fields with missing ends (NaN): {len(missing)}, e.g. " + "; ".join(
-            f"{r['seed']} {r['method']}/{r['variant']} {r['vectors'] - r['valid']} of {r['vectors']}"
-            for r in missing[:6]))
+        lines.append(
+            f"diffusion/auto fields with missing ends (NaN): {len(missing)}, e.g. "
+            + "; ".join(
+                f"{r['seed']} {r['method']}/{r['variant']} {r['vectors'] - r['valid']} of {r['vectors']}"
+                for r in missing[:6]
+            )
+        )
     slow = sorted((r for r in records if r["outcome"] in ("ok", "error")), key=lambda r: -r.get("wall", 0))[:5]
     lines.append("slowest: " + "; ".join(f"{r['seed']} {r['method']}/{r['variant']} {r['wall']:.1f} s" for r in slow))
     per_method = collections.defaultdict(float)
@@ -507,9 +541,11 @@ def _check(run, category):
     if not found:
         return
     by_variant = collections.Counter(f"{r['method']}/{r['variant']}" for r, _ in found)
-    lines = [f"{len(found)} {category} failures in {run['dim']}D "
-             f"({', '.join(f'{k}: {v}' for k, v in by_variant.most_common())}); "
-             f"fresh seeds this run: {run['fresh']}"]
+    lines = [
+        f"{len(found)} {category} failures in {run['dim']}D "
+        f"({', '.join(f'{k}: {v}' for k, v in by_variant.most_common())}); "
+        f"fresh seeds this run: {run['fresh']}"
+    ]
     for record, message in found[:40]:
         lines.append(f"- {_describe(record)}: {message[:400]}")
         lines.append(f"    {reproduce(record)}")

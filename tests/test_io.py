@@ -90,7 +90,9 @@ def test_3d_field_round_trips_with_its_faces(tmp_path):
     (tmp_path / "bad.csv").write_text("\n".join(text[: len(field) + 2] + ["0,1,99999"]) + "\n")
     with pytest.raises(ValueError, match="bad.csv: faces: vertex index 99999"):
         mm.read_field(tmp_path / "bad.csv")
-    (tmp_path / "flat.csv").write_text("start_x,start_y,end_x,end_y,valid,method\n0,0,1,1,1,normal\nface_a,face_b,face_c\n0,0,0\n")
+    (tmp_path / "flat.csv").write_text(
+        "start_x,start_y,end_x,end_y,valid,method\n0,0,1,1,1,normal\nface_a,face_b,face_c\n0,0,0\n"
+    )
     with pytest.raises(ValueError, match="a 2D field has no faces"):
         mm.read_field(tmp_path / "flat.csv")
 

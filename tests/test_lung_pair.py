@@ -1,6 +1,6 @@
 """A branching lung-like pair in 3D: plain normal mapping folds, "auto" must not.
 
-The pair (morphomap.data.make_lung): S1 is a trunk tube that splits into two daughters; by S2 the
+The pair (morphomap.synthetic.lung): S1 is a trunk tube that splits into two daughters; by S2 the
 daughters have grown on and each has budded a side branch, and the whole is dilated, so that S1
 lies strictly inside S2 (3D diffusion needs nested surfaces). Both are meshed from implicit
 functions with marching cubes.
@@ -14,7 +14,7 @@ import morphomap as mm
 trimesh = pytest.importorskip("trimesh")
 pytest.importorskip("skimage")
 
-from morphomap.data.make_lung import DILATION, lung_pair  # noqa: E402
+from morphomap.synthetic.lung import DILATION, lung_pair  # noqa: E402
 
 LONG_BUDS = 1.0  # growth at which reverse diffusion's images of the buds tilt past 90 degrees
 

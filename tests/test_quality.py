@@ -174,7 +174,7 @@ def reference(s1, s2, curve1, curve2):
         j = (i + 1) % m
         if np.isnan(s1[i]) or np.isnan(s1[j]):
             continue
-        l, inner1 = curve1.way(s1[i], s1[j])
+        l, inner1 = curve1.way(s1[i], s1[j])  # noqa: E741 (the paper's l_i)
         L, inner2 = curve2.way(s2[j], s2[i])
         if l > 0:
             terms.append((L / (alpha * l) - 1) ** 2)

@@ -273,7 +273,7 @@ def test_an_interrupted_write_leaves_the_old_file(tmp_path):
         def __iter__(self):
             raise KeyboardInterrupt
 
-    from morphomap._atomic import atomic_text
+    from morphomap.io.atomic import atomic_text
     with pytest.raises(KeyboardInterrupt):
         with atomic_text(target) as handle:
             handle.write("start_x,start_y\n")

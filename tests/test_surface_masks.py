@@ -114,5 +114,5 @@ def test_remesh_refuses_what_it_cannot_remesh():
     with pytest.raises(ValueError, match="surface: face 0 refers to vertex"):
         mm._core.remesh_surface(sphere.vertices, sphere.faces + 1000, 0.2, 1)
     # The orientation is kept, inwards included.
-    v, f = mm._core.remesh_surface(sphere.vertices, sphere.faces[:, ::-1], 0.2, 2)
-    assert trimesh.Trimesh(v, f, process=False).volume < 0
+    remeshed = mm._core.remesh_surface(sphere.vertices, sphere.faces[:, ::-1], 0.2, 2)
+    assert trimesh.Trimesh(remeshed["vertices"], remeshed["faces"], process=False).volume < 0

@@ -447,6 +447,33 @@ def test_random_arrays_never_crash(vertices, faces, queries):
             pass
 
 
+@st.composite
+def well_formed_soups(draw):
+    """Triangle soups that pass the array checks (shape (N, 3), indices in range), so that the C++
+    checks and kernels see them: degenerate, open, non-manifold, inward or tangled."""
+    n = draw(st.integers(3, 10))
+    vertices = draw(hnp.arrays(np.float64, (n, 3), elements=st.sampled_from([-1.0, 0.0, 0.5, 1.0]) | finite))
+    faces = draw(hnp.arrays(np.int64, st.tuples(st.integers(1, 14), st.just(3)), elements=st.integers(0, n - 1)))
+    return vertices, faces
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(soup=well_formed_soups(), other=well_formed_soups(),
+       queries=hnp.arrays(np.float64, st.tuples(st.integers(1, 5), st.just(3)), elements=finite))
+def test_well_formed_soups_reach_the_core_and_never_crash(soup, other, queries):
+    for call in (
+        lambda: mm.map_surfaces(soup, other),
+        lambda: mm.map_surfaces(soup, other, "minimal_distance"),
+        lambda: mm.SurfaceIndex(*soup).closest_points(queries),
+        lambda: mm.SurfaceIndex(*soup).line_intersections(queries, queries + 1),
+        lambda: mm.surface_normals(*soup),
+    ):
+        try:
+            call()
+        except (ValueError, mm.GeometryError):
+            pass
+
+
 def cube():
     """The cube [-1, 1]^3, each square split along a diagonal; outward faces."""
     v = np.array([[x, y, z] for x in (-1.0, 1.0) for y in (-1.0, 1.0) for z in (-1.0, 1.0)])

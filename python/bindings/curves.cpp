@@ -10,6 +10,7 @@
 #include <morphomap/resample.hpp>
 
 namespace py = pybind11;
+using namespace pybind11::literals;  // results cross as dicts keyed by field name
 using namespace morphomap;
 
 namespace {
@@ -23,9 +24,9 @@ ResampleMethod resample_method(const std::string& name) {
   throw morphomap::InvalidInput("method: expected 'linear', 'spline' or 'pchip', got '" + name + "'");
 }
 
-py::tuple hits_tuple(CurveHits&& h) {
-  return py::make_tuple(std::move(h.points), std::move(h.distances), std::move(h.segments),
-                        std::move(h.arc_lengths));
+py::dict hits_record(CurveHits&& h) {
+  return py::dict("points"_a = std::move(h.points), "distances"_a = std::move(h.distances),
+                  "segments"_a = std::move(h.segments), "arc_lengths"_a = std::move(h.arc_lengths));
 }
 
 }  // namespace
@@ -60,7 +61,7 @@ void bind_curves(py::module_& m) {
               py::gil_scoped_release release;
               hits = index.closest_points(queries);
             }
-            return hits_tuple(std::move(hits));
+            return hits_record(std::move(hits));
           },
           py::arg("queries"))
       .def(
@@ -71,7 +72,7 @@ void bind_curves(py::module_& m) {
               py::gil_scoped_release release;
               hits = index.line_intersections(origins, directions);
             }
-            return hits_tuple(std::move(hits));
+            return hits_record(std::move(hits));
           },
           py::arg("origins"), py::arg("directions"));
 
@@ -83,9 +84,9 @@ void bind_curves(py::module_& m) {
           py::gil_scoped_release release;
           found = curve_intersections(c1, c2, closed);
         }
-        return py::make_tuple(std::move(found.points), std::move(found.arc_lengths1),
-                              std::move(found.arc_lengths2), std::move(found.segments1),
-                              std::move(found.segments2));
+        return py::dict("points"_a = std::move(found.points), "arc_lengths1"_a = std::move(found.arc_lengths1),
+                        "arc_lengths2"_a = std::move(found.arc_lengths2),
+                        "segments1"_a = std::move(found.segments1), "segments2"_a = std::move(found.segments2));
       },
       py::arg("c1"), py::arg("c2"), py::arg("closed"));
 

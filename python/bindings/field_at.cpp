@@ -5,6 +5,7 @@
 #include <morphomap/field_at.hpp>
 
 namespace py = pybind11;
+using namespace pybind11::literals;  // results cross as dicts keyed by field name
 using namespace morphomap;
 
 void bind_field_at(py::module_& m) {
@@ -17,7 +18,7 @@ void bind_field_at(py::module_& m) {
           py::gil_scoped_release release;
           at = displacement_at(DisplacementField2{starts, ends, {}}, source, closed, points);
         }
-        return py::make_tuple(std::move(at.displacements), std::move(at.distances));
+        return py::dict("displacements"_a = std::move(at.displacements), "distances"_a = std::move(at.distances));
       },
       py::arg("starts"), py::arg("ends"), py::arg("source"), py::arg("closed"), py::arg("points"));
   m.def(
@@ -28,7 +29,7 @@ void bind_field_at(py::module_& m) {
           py::gil_scoped_release release;
           at = displacement_at(DisplacementField3{starts, ends, faces, {}}, points);
         }
-        return py::make_tuple(std::move(at.displacements), std::move(at.distances));
+        return py::dict("displacements"_a = std::move(at.displacements), "distances"_a = std::move(at.distances));
       },
       py::arg("starts"), py::arg("ends"), py::arg("faces"), py::arg("points"));
 }

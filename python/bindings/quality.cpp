@@ -7,6 +7,7 @@
 #include "interrupt_guard.hpp"
 
 namespace py = pybind11;
+using namespace pybind11::literals;  // results cross as dicts keyed by field name
 using namespace morphomap;
 
 void bind_quality(py::module_& m) {
@@ -21,7 +22,7 @@ void bind_quality(py::module_& m) {
           DisplacementField2 field{starts, ends, {}};
           q = quality(field, c1, c2, closed);
         }
-        return py::make_tuple(q.qm1, q.qm2, q.qm, q.crossings);
+        return py::dict("qm1"_a = q.qm1, "qm2"_a = q.qm2, "qm"_a = q.qm, "crossings"_a = q.crossings);
       },
       py::arg("starts"), py::arg("ends"), py::arg("c1"), py::arg("c2"), py::arg("closed"));
 }

@@ -14,6 +14,7 @@
 #include "interrupt_guard.hpp"
 
 namespace py = pybind11;
+using namespace pybind11::literals;  // results cross as dicts keyed by field name
 using namespace morphomap;
 
 namespace {
@@ -28,8 +29,9 @@ MapMethod surface_method(const std::string& name) {
   throw InvalidInput("method: expected 'minimal_distance', 'normal', 'diffusion' or 'auto', got '" + name + "'");
 }
 
-py::tuple hits_tuple(SurfaceHits&& h) {
-  return py::make_tuple(std::move(h.points), std::move(h.distances), std::move(h.faces));
+py::dict hits_record(SurfaceHits&& h) {
+  return py::dict("points"_a = std::move(h.points), "distances"_a = std::move(h.distances),
+                  "faces"_a = std::move(h.faces));
 }
 
 }  // namespace
@@ -45,7 +47,7 @@ void bind_surfaces(py::module_& m) {
               py::gil_scoped_release release;
               hits = index.closest_points(queries);
             }
-            return hits_tuple(std::move(hits));
+            return hits_record(std::move(hits));
           },
           py::arg("queries"))
       .def(
@@ -56,7 +58,7 @@ void bind_surfaces(py::module_& m) {
               py::gil_scoped_release release;
               hits = index.line_intersections(origins, directions);
             }
-            return hits_tuple(std::move(hits));
+            return hits_record(std::move(hits));
           },
           py::arg("origins"), py::arg("directions"));
 
@@ -100,7 +102,7 @@ void bind_surfaces(py::module_& m) {
           DisplacementField3 field{starts, ends, faces, {}};
           q = quality(field, v1, f1, v2, f2);
         }
-        return py::make_tuple(q.qm1, q.qm2, q.qm, q.folds);
+        return py::dict("qm1"_a = q.qm1, "qm2"_a = q.qm2, "qm"_a = q.qm, "folds"_a = q.folds);
       },
       py::arg("starts"), py::arg("ends"), py::arg("faces"), py::arg("v1"), py::arg("f1"), py::arg("v2"),
       py::arg("f2"));
@@ -122,7 +124,7 @@ void bind_surfaces(py::module_& m) {
           py::gil_scoped_release release;
           surface = remesh_surface(vertices, faces, edge_length, iterations);
         }
-        return py::make_tuple(std::move(surface.vertices), std::move(surface.faces));
+        return py::dict("vertices"_a = std::move(surface.vertices), "faces"_a = std::move(surface.faces));
       },
       py::arg("vertices"), py::arg("faces"), py::arg("edge_length"), py::arg("iterations"));
 }

@@ -23,16 +23,22 @@ from .diffusion import DiffusionSolution, solve_diffusion
 from .diffusion3d import ShellDiffusionSolution, solve_diffusion_3d
 from .extend import InteriorField, extend_field
 from .field import DisplacementField
-from .images import Image, read_image
-from .io import load_example, read_curve, read_field, write_curve, write_field
+from .images import Image, boundary_from_mask, read_image, surface_from_mask
+from .io import (
+    load_example,
+    read_curve,
+    read_field,
+    read_surface,
+    write_curve,
+    write_field,
+    write_interior,
+    write_surface,
+)
 from .mapping import map_curves
-from .masks import boundary_from_mask, surface_from_mask
-from .mesh_files import read_surface, write_surface
 from .plot import plot_field, plot_field_3d
 from .quality import CurveQuality, SurfaceQuality, quality
 from .batch import Job, map_batch
 from .series import Series, map_series
-from .solver_files import write_interior
 from .queries import CurveHits, CurveIndex, closest_points, line_intersections
 from .surfaces import SurfaceHits, SurfaceIndex, map_surfaces, surface_normals
 from .transform import Similarity, align_curves, overlap_area

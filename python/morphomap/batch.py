@@ -38,7 +38,7 @@ def run_job(job: Job) -> str:
 
     import morphomap as mm
 
-    from .frames import read_boundary
+    from .io.frames import read_boundary
 
     (b1, _), (b2, _) = (read_boundary(p, spacing=job.spacing, smooth=job.smooth) for p in (job.c1, job.c2))
     if isinstance(b1, np.ndarray):

@@ -96,7 +96,7 @@ def curve_intersections(c1, c2, *, closed=True, return_arc_lengths=False):
         on ``c2``, measured from their first points.
     """
     closed = as_flag(closed, "closed")
-    points, s1, s2, _, _ = _core.curve_intersections(as_points(c1, "c1"), as_points(c2, "c2"), closed)
+    found = _core.curve_intersections(as_points(c1, "c1"), as_points(c2, "c2"), closed)
     if as_flag(return_arc_lengths, "return_arc_lengths"):
-        return points, s1, s2
-    return points
+        return found["points"], found["arc_lengths1"], found["arc_lengths2"]
+    return found["points"]

@@ -150,7 +150,7 @@ class DisplacementField:
         if self.dim == 3:
             if self._faces is None:
                 raise ValueError("field: a 3D field needs its faces to interpolate (read it from a CSV with faces)")
-            displacements, distances = _core.displacement_at_3d(self._starts, self._ends, self._faces, points)
+            at = _core.displacement_at_3d(self._starts, self._ends, self._faces, points)
         else:
             if source is None:
                 source = self._source
@@ -158,9 +158,8 @@ class DisplacementField:
             if source is None:
                 raise ValueError("source: this field does not know the curve it was made from: pass source=C1")
             closed = as_flag(True if closed is None else closed, "closed")
-            displacements, distances = _core.displacement_at_2d(
-                self._starts, self._ends, as_points(source, "source", 2), closed, points)
-        return (displacements, distances) if return_distances else displacements
+            at = _core.displacement_at_2d(self._starts, self._ends, as_points(source, "source", 2), closed, points)
+        return (at["displacements"], at["distances"]) if return_distances else at["displacements"]
 
     @property
     def dim(self) -> int:

@@ -7,7 +7,7 @@ import sys
 
 import numpy as np
 
-from ._atomic import atomic_path
+from .io.atomic import atomic_path
 from ._validate import as_flag, as_points
 from .crossings import crossing_pairs
 from .field import DisplacementField
@@ -155,19 +155,28 @@ def plot_field_3d(field, s1, s2, ax=None, *, title=None):
     valid = np.flatnonzero(field.valid)
     shown = valid[np.linspace(0, len(valid) - 1, min(len(valid), MAX_VECTORS_3D)).astype(int)] if len(valid) else valid
     lengths = np.linalg.norm(field.vectors[shown], axis=1)
+    drawn = f", {len(shown)} drawn)" if len(shown) < len(valid) else ")"
     lines = Line3DCollection(np.stack([field.starts[shown], field.ends[shown]], axis=1), cmap="viridis",
-                             linewidths=0.8, label=f"vectors ({len(valid)}" + (f", {len(shown)} drawn)" if len(shown) < len(valid) else ")"))
+                             linewidths=0.8, label=f"vectors ({len(valid)}" + drawn)
     lines.set_array(lengths)
     ax.add_collection3d(lines)
     ax.figure.colorbar(lines, ax=ax, shrink=0.6, label="vector length")
     missed = ~field.valid & np.isfinite(field.starts).all(axis=1)
     if missed.any():
-        ax.scatter(*field.starts[missed].T, marker="x", s=14, color=MISS_COLOUR, label=f"no target ({int(missed.sum())})")
+        ax.scatter(
+            *field.starts[missed].T, marker="x", s=14, color=MISS_COLOUR, label=f"no target ({int(missed.sum())})"
+        )
     everything = np.vstack([surfaces[0][0], surfaces[1][0]])
     low, high = everything.min(axis=0), everything.max(axis=0)
     centre, half = (low + high) / 2, (high - low).max() / 2
-    ax.set(xlim=(centre[0] - half, centre[0] + half), ylim=(centre[1] - half, centre[1] + half),
-           zlim=(centre[2] - half, centre[2] + half), xlabel="x", ylabel="y", zlabel="z")
+    ax.set(
+        xlim=(centre[0] - half, centre[0] + half),
+        ylim=(centre[1] - half, centre[1] + half),
+        zlim=(centre[2] - half, centre[2] + half),
+        xlabel="x",
+        ylabel="y",
+        zlabel="z",
+    )
     ax.set_box_aspect((1, 1, 1))
     ax.legend(loc="upper left", fontsize="small", framealpha=0.8)
     if title is not None:

@@ -117,16 +117,19 @@ def quality(field, c1, c2, *, closed=True):
         raise TypeError(f"field: expected a DisplacementField, got {type(field).__name__}")
     if field.dim == 3:
         if field.faces is None:
-            raise ValueError("field: expected a 2D field, or a 3D field with faces (the connectivity of its start points)")
+            raise ValueError(
+                "field: expected a 2D field, or a 3D field with faces (the connectivity of its start points)"
+            )
         v1, f1 = as_surface(c1, "s1")
         v2, f2 = as_surface(c2, "s2")
-        qm1, qm2, qm, folds = _core.surface_quality(
-            field.starts, field.ends, np.ascontiguousarray(field.faces, dtype=np.int64), v1, f1, v2, f2)
-        return SurfaceQuality(float(qm1), float(qm2), float(qm), int(folds))
+        found = _core.surface_quality(
+            field.starts, field.ends, np.ascontiguousarray(field.faces, dtype=np.int64), v1, f1, v2, f2
+        )
+        return SurfaceQuality(float(found["qm1"]), float(found["qm2"]), float(found["qm"]), int(found["folds"]))
     if field.dim != 2:
         raise ValueError(f"field: expected a 2D displacement field, got {field.dim}D")
     c1 = as_points(c1, "c1")
     c2 = as_points(c2, "c2")
     closed = as_flag(closed, "closed")
-    qm1, qm2, qm, crossings = _core.curve_quality(field.starts, field.ends, c1, c2, closed)
-    return CurveQuality(float(qm1), float(qm2), float(qm), int(crossings))
+    found = _core.curve_quality(field.starts, field.ends, c1, c2, closed)
+    return CurveQuality(float(found["qm1"]), float(found["qm2"]), float(found["qm"]), int(found["crossings"]))

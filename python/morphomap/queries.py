@@ -52,7 +52,7 @@ class CurveIndex:
 
         queries : (M, 2) float
         """
-        return CurveHits(*self._index.closest_points(as_points(queries, "queries")))
+        return CurveHits(**self._index.closest_points(as_points(queries, "queries")))
 
     def line_intersections(self, origins, directions) -> CurveHits:
         """Nearest intersection of each whole line ``origin + t * direction`` (t of either sign).
@@ -62,7 +62,7 @@ class CurveIndex:
         """
         origins = as_points(origins, "origins")
         directions = as_points(directions, "directions")
-        return CurveHits(*self._index.line_intersections(origins, directions))
+        return CurveHits(**self._index.line_intersections(origins, directions))
 
 
 def closest_points(queries, curve, *, closed=True) -> CurveHits:

@@ -128,7 +128,7 @@ class Series:
 
         Writes are atomic.
         """
-        from ._atomic import atomic_text
+        from .io.atomic import atomic_text
         from .io import write_field
 
         os.makedirs(folder, exist_ok=True)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._atomic import atomic_path
+from .io.atomic import atomic_path
 from .plot import C1_COLOUR, _new_axes
 
 #: At most this many trajectories are drawn in 3D (evenly chosen): more only hide the surfaces.

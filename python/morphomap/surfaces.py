@@ -62,7 +62,7 @@ class SurfaceIndex:
 
         queries : (M, 3) float
         """
-        return SurfaceHits(*self._index.closest_points(as_points(queries, "queries", 3)))
+        return SurfaceHits(**self._index.closest_points(as_points(queries, "queries", 3)))
 
     def line_intersections(self, origins, directions) -> SurfaceHits:
         """Nearest intersection of each whole line ``origin + t * direction`` (t of either sign).
@@ -72,7 +72,7 @@ class SurfaceIndex:
         """
         origins = as_points(origins, "origins", 3)
         directions = as_points(directions, "directions", 3)
-        return SurfaceHits(*self._index.line_intersections(origins, directions))
+        return SurfaceHits(**self._index.line_intersections(origins, directions))
 
 
 def surface_normals(vertices, faces) -> np.ndarray:

@@ -6,7 +6,6 @@ starting points of the displacement vectors back onto C1 with ``Similarity.apply
 
 from __future__ import annotations
 
-import math
 import numbers
 from dataclasses import dataclass
 
@@ -40,21 +39,17 @@ class Similarity:
         object.__setattr__(self, "scale", float(self.scale))
         object.__setattr__(self, "angle", float(self.angle))
 
-    def _matrix(self) -> np.ndarray:
-        c, s = math.cos(self.angle), math.sin(self.angle)
-        return np.array([[c, -s], [s, c]])
-
     def apply(self, points) -> np.ndarray:
         """The points moved: ``(N, 2)`` float."""
-        p = as_points(points, "points", allow_nan=True)
-        return self.centre + self.translation + self.scale * (p - self.centre) @ self._matrix().T
+        return self._apply(points, inverse=False)
 
     def apply_inverse(self, points) -> np.ndarray:
         """The points moved back (the inverse of :meth:`apply`): ``(N, 2)`` float."""
-        if self.scale == 0 or not math.isfinite(self.scale):
-            raise ValueError(f"scale: the similarity has no inverse (scale {self.scale})")
+        return self._apply(points, inverse=True)
+
+    def _apply(self, points, *, inverse: bool) -> np.ndarray:
         p = as_points(points, "points", allow_nan=True)
-        return self.centre + ((p - self.centre - self.translation) @ self._matrix()) / self.scale
+        return _core.apply_similarity(self.centre, self.scale, self.angle, self.translation, p, inverse)
 
 
 def overlap_area(a, b) -> float:
@@ -83,10 +78,6 @@ def align_curves(c1, c2, *, closed=True, tolerance=1e-6) -> Similarity:
     closed = as_flag(closed, "closed")
     if isinstance(tolerance, (bool, np.bool_)) or not isinstance(tolerance, numbers.Real):
         raise TypeError(f"tolerance: expected a real number, got {type(tolerance).__name__}")
-    tolerance = float(tolerance)
-    if not (math.isfinite(tolerance) and tolerance > 0):
-        raise ValueError(f"tolerance: must be positive and finite, got {tolerance}")
-    centre, scale, angle, translation = _core.align_curves(
-        as_points(c1, "c1"), as_points(c2, "c2"), closed, tolerance
-    )
-    return Similarity(centre, scale, angle, translation)
+    # The value rule (positive and finite) is the C++ core's.
+    found = _core.align_curves(as_points(c1, "c1"), as_points(c2, "c2"), closed, float(tolerance))
+    return Similarity(found["centre"], found["scale"], found["angle"], found["translation"])

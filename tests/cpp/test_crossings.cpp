@@ -3,7 +3,7 @@
 #include <morphomap/errors.hpp>
 
 #include "check.hpp"
-#include "crossing_sweep.hpp"
+#include "curves/crossing_sweep.hpp"
 
 #include <algorithm>
 #include <cmath>

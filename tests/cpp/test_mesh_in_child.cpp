@@ -1,7 +1,7 @@
 // The child-process guard around Mesh_3 (an internal of the core, tested through its header): a
 // mesh comes back intact, the core's exceptions come back as themselves, and a crash in the child
 // becomes MesherCrashed while this process carries on.
-#include "mesh_in_child.hpp"
+#include "diffusion/mesh_in_child.hpp"
 
 #include <morphomap/errors.hpp>
 

@@ -6,8 +6,6 @@
 
 namespace morphomap {
 
-using Triangles = Eigen::Matrix<Index, Eigen::Dynamic, 3, Eigen::RowMajor>;
-
 struct DiffusionOptions {
   // Mesh size: the lattice spacing is 0.97 times it, and no edge along the curves is longer; in
   // the lattice, a triangle next to a point the mesher added may reach the lattice triangles'
@@ -22,7 +20,7 @@ struct DiffusionOptions {
 
 struct DiffusionSolution {
   Points2 vertices;     // the region mesh: every point of both curves is a vertex
-  Triangles triangles;  // counter-clockwise
+  Faces triangles;  // counter-clockwise
   Vector potential;     // c at the vertices: P1 finite elements, c = 1 on the source, 0 on the target
   Points2 ends;         // for each source point, where its streamline of -grad c meets the target
                         // (NaN if it does not)

@@ -1,0 +1,72 @@
+// The public CurveIndex: the arguments' checks and the answers' layout around the segment tree
+// (curve_tree.hpp).
+#include <morphomap/curve_queries.hpp>
+
+#include "common/validation.hpp"
+#include "curves/curve_tree.hpp"
+
+#include <string>
+
+namespace morphomap {
+
+struct CurveIndex::Impl : curve_tree::Tree {
+  using Tree::Tree;
+};
+
+namespace {
+
+CurveHits allocate_hits(Index rows) {
+  CurveHits hits;
+  hits.points.resize(rows, 2);
+  hits.distances.resize(rows);
+  hits.segments.resize(rows);
+  hits.arc_lengths.resize(rows);
+  return hits;
+}
+
+}  // namespace
+
+CurveIndex::CurveIndex(const Points2Ref& curve, bool closed)
+    : impl_(std::make_unique<Impl>(curve, closed)) {}
+CurveIndex::~CurveIndex() = default;
+CurveIndex::CurveIndex(CurveIndex&&) noexcept = default;
+CurveIndex& CurveIndex::operator=(CurveIndex&&) noexcept = default;
+
+Index CurveIndex::size() const { return impl_->points; }
+bool CurveIndex::closed() const { return impl_->closed; }
+
+CurveHits CurveIndex::closest_points(const Points2Ref& queries) const {
+  detail::require_finite(queries, "queries");
+  CurveHits hits = allocate_hits(queries.rows());
+  impl_->closest_points(queries, hits);
+  return hits;
+}
+
+CurveHits CurveIndex::line_intersections(const Points2Ref& origins,
+                                         const Points2Ref& directions) const {
+  detail::require_finite(origins, "origins");
+  detail::require_finite(directions, "directions");
+  if (origins.rows() != directions.rows()) {
+    detail::invalid("directions", "has " + std::to_string(directions.rows()) +
+                                      " rows but origins has " + std::to_string(origins.rows()));
+  }
+  for (Index i = 0; i < directions.rows(); ++i) {
+    if (directions(i, 0) == 0.0 && directions(i, 1) == 0.0) {
+      detail::invalid("directions", "row " + std::to_string(i) + " is the zero vector");
+    }
+  }
+  CurveHits hits = allocate_hits(origins.rows());
+  impl_->line_intersections(origins, directions, hits);
+  return hits;
+}
+
+CurveHits closest_points(const Points2Ref& queries, const Points2Ref& curve, bool closed) {
+  return CurveIndex(curve, closed).closest_points(queries);
+}
+
+CurveHits line_intersections(const Points2Ref& origins, const Points2Ref& directions,
+                             const Points2Ref& curve, bool closed) {
+  return CurveIndex(curve, closed).line_intersections(origins, directions);
+}
+
+}  // namespace morphomap

@@ -1,0 +1,285 @@
+#include <morphomap/extend.hpp>
+
+#include <morphomap/field_at.hpp>
+
+#include "common/validation.hpp"
+#include "diffusion/dirichlet.hpp"
+#include "diffusion/region_mesh.hpp"
+#include "diffusion/volume_mesh.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace morphomap {
+namespace {
+
+// The nodes on the mesh's boundary: the corners of the cell faces (edges in 2D, triangles in
+// 3D) that only one cell has.
+template <class Cells>
+std::vector<char> boundary_nodes(const Cells& cells, Index node_count) {
+  constexpr int corners = Cells::ColsAtCompileTime;
+  using Side = std::array<Index, corners - 1>;
+  std::vector<Side> sides;
+  sides.reserve(cells.rows() * corners);
+  for (Index c = 0; c < cells.rows(); ++c) {
+    for (int skip = 0; skip < corners; ++skip) {
+      Side side;
+      for (int i = 0, k = 0; i < corners; ++i) {
+        if (i != skip) side[k++] = cells(c, i);
+      }
+      std::sort(side.begin(), side.end());
+      sides.push_back(side);
+    }
+  }
+  std::sort(sides.begin(), sides.end());
+  std::vector<char> on_boundary(node_count, 0);
+  for (std::size_t k = 0; k < sides.size();) {
+    std::size_t end = k + 1;
+    while (end < sides.size() && sides[end] == sides[k]) ++end;
+    if (end - k == 1) {
+      for (const Index v : sides[k]) on_boundary[v] = 1;
+    }
+    k = end;
+  }
+  return on_boundary;
+}
+
+template <class Points, class Cells>
+void require_mesh(const Points& points, const Cells& cells) {
+  if (!points.allFinite()) detail::invalid("mesh", "a point has a non-finite coordinate");
+  if (cells.rows() == 0) detail::invalid("mesh", "has no cells");
+  for (Index c = 0; c < cells.rows(); ++c) {
+    for (Index i = 0; i < cells.cols(); ++i) {
+      if (cells(c, i) < 0 || cells(c, i) >= points.rows()) {
+        detail::invalid("mesh", "cell " + std::to_string(c) + " refers to point " + std::to_string(cells(c, i)) +
+                                    ", outside 0.." + std::to_string(points.rows() - 1));
+      }
+    }
+  }
+}
+
+double signed_measure(const Points2& x, const Faces& cells, Index c) {
+  const Vec2 a = (x.row(cells(c, 1)) - x.row(cells(c, 0))).transpose(), b = (x.row(cells(c, 2)) - x.row(cells(c, 0))).transpose();
+  return 0.5 * (a.x() * b.y() - a.y() * b.x());
+}
+
+double signed_measure(const Points3& x, const Tetrahedra& cells, Index c) {
+  Eigen::Matrix3d edges;
+  for (int i = 0; i < 3; ++i) edges.col(i) = (x.row(cells(c, i + 1)) - x.row(cells(c, 0))).transpose();
+  return edges.determinant() / 6.0;
+}
+
+// Counts the cells the motion turns over or flattens and the smallest area (volume) ratio.
+template <class Interior>
+void measure_inversions(Interior& out) {
+  const auto moved = (out.points + out.displacement).eval();
+  out.inverted = 0;
+  out.min_jacobian = std::numeric_limits<double>::infinity();
+  for (Index c = 0; c < out.cells.rows(); ++c) {
+    const double before = signed_measure(out.points, out.cells, c);
+    const double ratio = before != 0 ? signed_measure(moved, out.cells, c) / before : 0.0;
+    if (!(ratio > 0)) ++out.inverted;
+    out.min_jacobian = std::min(out.min_jacobian, ratio);
+  }
+}
+
+// The field's displacement at the mesh's boundary nodes (`fixed`; zero elsewhere until solved),
+// from project(boundary node positions), and the farthest of those nodes from the boundary.
+template <class Interior, class Project>
+void take_boundary_values(Interior& out, const std::vector<char>& fixed, const Project& project) {
+  using Rows = decltype(out.points);
+  std::vector<Index> nodes;
+  for (Index v = 0; v < out.points.rows(); ++v) {
+    if (fixed[v]) nodes.push_back(v);
+  }
+  Rows at(nodes.size(), out.points.cols());
+  for (std::size_t k = 0; k < nodes.size(); ++k) at.row(k) = out.points.row(nodes[k]);
+  const auto boundary = project(at);
+  out.displacement = Rows::Zero(out.points.rows(), out.points.cols());
+  Index missing = 0;
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    out.displacement.row(nodes[k]) = boundary.displacements.row(k);
+    missing += !boundary.displacements.row(k).allFinite();
+  }
+  if (missing > 0) {
+    detail::invalid("field", "has no displacement at " + std::to_string(missing) + " of the " +
+                                 std::to_string(nodes.size()) + " boundary nodes (the field has no target there)");
+  }
+  out.boundary_distance = boundary.distances.size() ? boundary.distances.maxCoeff() : 0.0;
+}
+
+// Gradients of the barycentric coordinates of a cell (rows) and its signed area (volume).
+template <int D, class Points, class Cells>
+double simplex_gradients(const Points& x, const Cells& cells, Index c, Eigen::Matrix<double, D + 1, D>& g) {
+  Eigen::Matrix<double, D, D> edges;
+  for (int i = 0; i < D; ++i) edges.col(i) = (x.row(cells(c, i + 1)) - x.row(cells(c, 0))).transpose();
+  const Eigen::Matrix<double, D, D> inverse = edges.inverse();
+  g.template bottomRows<D>() = inverse;
+  g.row(0) = -inverse.colwise().sum();
+  return edges.determinant() / (D == 2 ? 2.0 : 6.0);
+}
+
+// One solve on the mesh at positions x: `values` holds the displacement at the fixed nodes; the
+// others get the method's solution. P1 elements; in 3D conjugate gradients first (less memory).
+template <int D, class Points, class Cells>
+Eigen::MatrixXd extension_step(const Points& x, const Cells& cells, const std::vector<char>& fixed,
+                               Eigen::MatrixXd values, const ExtendOptions& options) {
+  constexpr int corners = D + 1;
+  const bool iterative = D == 3;
+  // An affine boundary map must come back to rounding, not to the diffusion solver's 1e-10.
+  constexpr double tolerance = 1e-12;
+  if (options.method == ExtensionMethod::harmonic) {
+    // One scalar Laplacian; each component a column of the right-hand side.
+    return detail::solve_dirichlet_values(x.rows(), cells, fixed, std::move(values), [&](Index c) {
+      Eigen::Matrix<double, corners, D> g;
+      const double measure = std::abs(simplex_gradients<D>(x, cells, c, g));
+      return Eigen::Matrix<double, corners, corners>(measure * g * g.transpose());
+    }, iterative, tolerance, Eigen::MatrixXd(x));
+  }
+  // Linear elasticity with Young's modulus 1 (it cancels with Dirichlet data only): the unknowns
+  // are the components, node * D + component, coupled through the strain.
+  const double nu = options.poisson_ratio;
+  const double mu = 0.5 / (1.0 + nu), lambda = nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
+  Eigen::Matrix<Index, Eigen::Dynamic, corners * D, Eigen::RowMajor> dofs(cells.rows(), corners * D);
+  for (Index c = 0; c < cells.rows(); ++c) {
+    for (int i = 0; i < corners; ++i) {
+      for (int a = 0; a < D; ++a) dofs(c, i * D + a) = cells(c, i) * D + a;
+    }
+  }
+  std::vector<char> dof_fixed(x.rows() * D);
+  Eigen::MatrixXd flat(x.rows() * D, 1), positions(x.rows() * D, D);
+  for (Index v = 0; v < x.rows(); ++v) {
+    for (int a = 0; a < D; ++a) {
+      dof_fixed[v * D + a] = fixed[v];
+      flat(v * D + a, 0) = values(v, a);
+      positions.row(v * D + a) = x.row(v);
+    }
+  }
+  flat = detail::solve_dirichlet_values(x.rows() * D, dofs, dof_fixed, std::move(flat), [&](Index c) {
+    Eigen::Matrix<double, corners, D> g;
+    const double measure = std::abs(simplex_gradients<D>(x, cells, c, g));
+    // The bilinear form 2 mu eps(u):eps(v) + lambda div u div v for u = phi_j e_b, v = phi_i e_a.
+    Eigen::Matrix<double, corners * D, corners * D> k;
+    for (int i = 0; i < corners; ++i) {
+      for (int j = 0; j < corners; ++j) {
+        const double dot = g.row(i).dot(g.row(j));
+        for (int a = 0; a < D; ++a) {
+          for (int b = 0; b < D; ++b) {
+            k(i * D + a, j * D + b) =
+                measure * (mu * (a == b ? dot : 0.0) + mu * g(i, b) * g(j, a) + lambda * g(i, a) * g(j, b));
+          }
+        }
+      }
+    }
+    return k;
+  }, iterative, tolerance, positions);
+  for (Index v = 0; v < x.rows(); ++v) {
+    for (int a = 0; a < D; ++a) values(v, a) = flat(v * D + a, 0);
+  }
+  return values;
+}
+
+// The motion of the interior: out.displacement holds the boundary displacement at the fixed
+// nodes on entry, the displacement of every node on return. In substeps, each moving the
+// boundary by an equal share of what remains and solving on the mesh as moved so far.
+template <int D, class Interior>
+void solve_motion(Interior& out, const std::vector<char>& fixed, const ExtendOptions& options) {
+  // A flat cell has no gradients: its stiffness would be infinite.
+  for (Index c = 0; c < out.cells.rows(); ++c) {
+    if (!(std::abs(signed_measure(out.points, out.cells, c)) > 0)) {
+      detail::invalid("mesh", "cell " + std::to_string(c) + " is flat (zero " + (D == 2 ? "area" : "volume") + ")");
+    }
+  }
+  const Eigen::MatrixXd boundary = out.displacement;
+  Eigen::MatrixXd total = Eigen::MatrixXd::Zero(out.points.rows(), D);
+  auto moved = out.points;
+  for (int step = 0; step < options.substeps; ++step) {
+    const Eigen::MatrixXd share = (boundary - total) / static_cast<double>(options.substeps - step);
+    const Eigen::MatrixXd increment = extension_step<D>(moved, out.cells, fixed, share, options);
+    if (!increment.allFinite()) {
+      throw GeometryError(std::string("the ") + (options.method == ExtensionMethod::harmonic ? "harmonic" : "elastic") +
+                          " extension has no finite solution on this mesh" +
+                          (step > 0 ? " (substep " + std::to_string(step + 1) + " flattened a cell)" : ""));
+    }
+    total += increment;
+    moved += increment;
+  }
+  out.displacement = total;
+  measure_inversions(out);
+}
+
+void require_options(const ExtendOptions& options) {
+  if (!(options.poisson_ratio >= 0.0 && options.poisson_ratio < 0.5)) {
+    detail::invalid("poisson_ratio", "must be at least 0 and below 0.5, got " + std::to_string(options.poisson_ratio));
+  }
+  if (options.substeps < 1) detail::invalid("substeps", "must be at least 1, got " + std::to_string(options.substeps));
+  if (!std::isfinite(options.mesh_size)) detail::invalid("mesh_size", "must be finite");
+}
+
+// The mesh size for Mesh_3: the one asked for, else the start triangles' mean edge (checking that
+// every corner has a start point, as the surface to mesh).
+double default_size(const DisplacementField3& field, const ExtendOptions& options) {
+  if (field.faces.rows() == 0) detail::invalid("field", "has no triangles to mesh the region they enclose");
+  double total = 0.0;
+  for (Index f = 0; f < field.faces.rows(); ++f) {
+    for (int i = 0; i < 3; ++i) {
+      const Index a = field.faces(f, i);
+      if (a < 0 || a >= field.starts.rows() || !field.starts.row(a).allFinite()) {
+        detail::invalid("field", "triangle " + std::to_string(f) + " has a corner without a start point: pass mesh=");
+      }
+    }
+    for (int i = 0; i < 3; ++i) {
+      total += (field.starts.row(field.faces(f, i)) - field.starts.row(field.faces(f, (i + 1) % 3))).norm();
+    }
+  }
+  return options.mesh_size > 0.0 ? options.mesh_size : total / (3.0 * field.faces.rows());
+}
+
+}  // namespace
+
+InteriorField2 extend_field(const DisplacementField2& field, const Points2Ref& source, const Points2Ref& mesh_points,
+                            const FacesRef& mesh_cells, const ExtendOptions& options) {
+  require_options(options);
+  detail::require_simple_curve(source, true, "source");
+  InteriorField2 out;
+  if (mesh_cells.rows() == 0) {
+    const detail::RegionMesh mesh =
+        detail::mesh_region({detail::without_repeats(source, true, "source")}, options.mesh_size);
+    out.points = mesh.vertices;
+    out.cells = mesh.triangles;
+  } else {
+    require_mesh(mesh_points, mesh_cells);
+    out.points = mesh_points;
+    out.cells = mesh_cells;
+  }
+  const std::vector<char> fixed = boundary_nodes(out.cells, out.points.rows());
+  take_boundary_values(out, fixed, [&](const Points2& at) { return displacement_at(field, source, true, at); });
+  solve_motion<2>(out, fixed, options);
+  return out;
+}
+
+InteriorField3 extend_field(const DisplacementField3& field, const Points3Ref& mesh_points,
+                            const TetrahedraRef& mesh_cells, const ExtendOptions& options) {
+  require_options(options);
+  InteriorField3 out;
+  if (mesh_cells.rows() == 0) {
+    const detail::VolumeMesh mesh = detail::mesh_volume(field.starts, field.faces, default_size(field, options),
+                                                        options.seed, "field");
+    out.points = mesh.vertices;
+    out.cells = mesh.tetrahedra;
+  } else {
+    require_mesh(mesh_points, mesh_cells);
+    out.points = mesh_points;
+    out.cells = mesh_cells;
+  }
+  const std::vector<char> fixed = boundary_nodes(out.cells, out.points.rows());
+  take_boundary_values(out, fixed, [&](const Points3& at) { return displacement_at(field, at); });
+  solve_motion<3>(out, fixed, options);
+  return out;
+}
+
+}  // namespace morphomap

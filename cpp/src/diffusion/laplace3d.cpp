@@ -1,0 +1,529 @@
+// Diffusion mapping in 3D: P1 finite elements for the Laplace equation on the tetrahedral mesh of
+// the region between two closed surfaces (a shell, or the pieces of the symmetric difference of
+// crossing surfaces), and streamlines of the recovered gradient.
+#include <morphomap/errors.hpp>
+#include <morphomap/laplace3d.hpp>
+#include <morphomap/surface_queries.hpp>
+
+#include "common/interrupt_check.hpp"
+#include "common/numbers.hpp"
+#include "common/validation.hpp"
+#include "diffusion/contact3d.hpp"
+#include "diffusion/dirichlet.hpp"
+#include "diffusion/mesh_in_child.hpp"
+#include "diffusion/shell_mesh.hpp"
+
+#include <Eigen/Dense>
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace morphomap {
+
+using detail::kNaN;
+
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+using Vec4 = Eigen::Vector4d;
+constexpr double kSourceFraction = 0.02;
+constexpr int kMeshAttempts = 3;
+constexpr double kFacetDistanceNested = 0.2;
+constexpr double kFacetDistanceCrossing = 0.05;
+// Surfaces closer than this fraction of their finer mean edge touch (as 2D's contact tolerance).
+constexpr double kTouchFraction = 0.01;
+// Where they come closer than this fraction of it, the source is pulled back to it (contact3d.hpp):
+// a thinner sliver would need elements of its own thickness.
+constexpr double kClearanceFraction = 0.5;
+constexpr int kClearanceAttempts = 5;
+using detail::free_vertex;
+using detail::source_vertex;
+using detail::target_vertex;
+using detail::crossing_vertex;
+
+struct SurfaceFacts {
+  double volume = 0.0;  // signed: positive when the faces are oriented outwards
+  double area = 0.0;
+  double mean_edge = 0.0;
+};
+
+// Checks the surface (closed, consistently oriented; see check_closed_surface) and measures it.
+SurfaceFacts check_surface(const Points3Ref& vertices, const FacesRef& faces, const char* name) {
+  SurfaceFacts facts;
+  facts.volume = check_closed_surface(vertices, faces, name);
+  for (Index f = 0; f < faces.rows(); ++f) {
+    const Vec3 a = vertices.row(faces(f, 0)).transpose(), b = vertices.row(faces(f, 1)).transpose(),
+               c = vertices.row(faces(f, 2)).transpose();
+    facts.area += 0.5 * (b - a).cross(c - a).norm();
+    facts.mean_edge += ((b - a).norm() + (c - b).norm() + (a - c).norm()) / 3.0;
+  }
+  facts.mean_edge /= faces.rows();
+  const double scale = (vertices.colwise().maxCoeff() - vertices.colwise().minCoeff()).norm();
+  if (!(std::abs(facts.volume) > 1e-12 * scale * scale * scale)) detail::invalid(name, "encloses no volume");
+  return facts;
+}
+
+// The P1 solution on the tetrahedra: local stiffness volume * grad phi_i . grad phi_j.
+Vector solve_potential(const detail::ShellMesh& mesh, const std::vector<char>& kind) {
+  return detail::solve_dirichlet(mesh.vertices.rows(), mesh.tetrahedra, kind, [&](Index t) {
+    Eigen::Matrix<double, 4, 3> g;
+    const double volume = std::abs(detail::tetrahedron_gradients(mesh.vertices, mesh.tetrahedra, t, g));
+    return Eigen::Matrix4d(volume * g * g.transpose());
+  }, true);
+}
+
+// Follows -grad c from the source boundary of the mesh to its target boundary. As in 2D, the P1
+// gradient (constant on each tetrahedron) is recovered at the vertices as the volume-weighted mean
+// over the tetrahedra around each, and normal to the surface at its Dirichlet vertices; that field
+// is interpolated linearly and integrated with RK4 steps of a fraction of the local element size,
+// each step followed as a straight segment from tetrahedron to tetrahedron until it stays inside
+// one or leaves the mesh through a face of the target.
+class Tracer {
+ public:
+  Tracer(const detail::ShellMesh& mesh, const Vector& c, const std::vector<char>& kind) : mesh_(mesh), c_(c) {
+    const Index n = mesh.vertices.rows(), tets = mesh.tetrahedra.rows();
+    velocity_.assign(n, Vec3::Zero());
+    std::vector<double> weight(n, 0.0);
+    std::vector<Vec3> normal(n, Vec3::Zero());
+    step_.resize(tets);
+    // Where the surfaces cross, c jumps from 1 to 0 along a curve and no smooth fit holds: in the
+    // tetrahedra at such a curve the flow is the element's own -grad c (the P1 field), which
+    // points away from the source faces and out through the target faces. NaN elsewhere.
+    element_flow_.assign(tets, Vec3::Constant(kNaN));
+    Eigen::Matrix<double, 4, 3> g;
+    for (Index t = 0; t < tets; ++t) {
+      const double volume = std::abs(detail::tetrahedron_gradients(mesh.vertices, mesh.tetrahedra, t, g));
+      Vec3 flow = Vec3::Zero();
+      bool at_crossing = false;
+      for (int i = 0; i < 4; ++i) {
+        flow -= c[mesh.tetrahedra(t, i)] * g.row(i).transpose();
+        at_crossing = at_crossing || kind[mesh.tetrahedra(t, i)] == crossing_vertex;
+      }
+      if (at_crossing) element_flow_[t] = flow;
+      double edges = 0.0;
+      for (int i = 0; i < 4; ++i) {
+        const Index v = mesh.tetrahedra(t, i);
+        velocity_[v] += volume * flow;
+        weight[v] += volume;
+        for (int j = i + 1; j < 4; ++j) edges += (point(v) - point(mesh.tetrahedra(t, j))).norm();
+      }
+      step_[t] = 0.25 * edges / 6.0;
+      for (int i = 0; i < 4; ++i) {
+        if (mesh.patches(t, i) != detail::source_face && mesh.patches(t, i) != detail::target_face) continue;
+        // Boundary face opposite vertex i: its (unnormalised) normal, the sign does not matter.
+        const Index a = mesh.tetrahedra(t, (i + 1) % 4), b = mesh.tetrahedra(t, (i + 2) % 4),
+                    d = mesh.tetrahedra(t, (i + 3) % 4);
+        Vec3 m = (point(b) - point(a)).cross(point(d) - point(a));
+        if (m.dot(point(a) - point(mesh.tetrahedra(t, i))) < 0.0) m = -m;  // outwards
+        for (const Index v : {a, b, d}) normal[v] += m;
+      }
+    }
+    for (Index v = 0; v < n; ++v) {
+      if (weight[v] > 0.0) velocity_[v] /= weight[v];
+    }
+    recover_by_least_squares(c);
+    for (Index v = 0; v < n; ++v) {
+      // On the surfaces c is constant, so the flow is normal to them: into the region at the
+      // source (c = 1 is its maximum), out of it at the target. The fit only gives the speed (its
+      // sign may be wrong near a crossing curve, where c jumps).
+      if ((kind[v] == source_vertex || kind[v] == target_vertex) && normal[v].squaredNorm() > 0.0) {
+        const Vec3 outwards = normal[v].normalized();
+        const double speed = std::abs(velocity_[v].dot(outwards));
+        velocity_[v] = (kind[v] == source_vertex ? -speed : speed) * outwards;
+      }
+    }
+  }
+
+  // From x on the boundary face of tetrahedron t. Returns the exit point on the target boundary
+  // of the mesh, or NaN.
+  Vec3 trace(Index t, Vec3 x, std::vector<Vec3>* path) const {
+    const Vec3 lost(kNaN, kNaN, kNaN);
+    if (path) path->push_back(x);
+    int stalled = 0;
+    for (int step = 0; step < kStepLimit; ++step) {
+      if (step % 1024 == 0) detail::check_interrupt();
+      const double h = step_[t];
+      const Vec3 k1 = direction(t, x);
+      if (k1.squaredNorm() == 0.0) return stopped(locate(t, x), x);
+      const Vec3 k2 = direction(t, x + 0.5 * h * k1), k3 = direction(t, x + 0.5 * h * k2),
+                 k4 = direction(t, x + h * k3);
+      const Vec3 y = x + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+      const Vec3 before = x;
+      const int outcome = walk(t, x, y);
+      if (path) path->push_back(x);
+      // Pressed against a boundary that is not the target, a streamline stops moving.
+      stalled = x == before ? stalled + 1 : 0;
+      if (stalled == kStallLimit) return stopped(t, x);
+      if (outcome == reached_target) return x;
+      if (outcome == lost_way) return lost;
+    }
+    return lost;
+  }
+
+ private:
+  enum Outcome { inside = 0, reached_target = 1, lost_way = 2 };
+  static constexpr int kStepLimit = 100000;
+  static constexpr int kWalkLimit = 10000;
+  static constexpr int kStallLimit = 16;
+
+  Vec3 point(Index v) const { return mesh_.vertices.row(v).transpose(); }
+
+  // Where a streamline that stopped moving at x in tetrahedron t ends: at x if t touches a curve
+  // where the surfaces cross (the streamline has run into the curve, a point of the target) or
+  // has c = 0 at every corner (it is at the target's level), else nowhere (NaN).
+  Vec3 stopped(Index t, const Vec3& x) const {
+    bool level_zero = true;
+    for (int i = 0; i < 4; ++i) level_zero = level_zero && c_[mesh_.tetrahedra(t, i)] == 0.0;
+    if (level_zero || !std::isnan(element_flow_[t].x())) return x;
+    return Vec3::Constant(kNaN);
+  }
+
+  // The volume-weighted mean of the element gradients is only first-order accurate on an
+  // irregular mesh. Better: fit a quadratic to the nodal values around each vertex (its
+  // neighbours, and theirs where there are few), weighted by inverse squared distance; its
+  // gradient at the vertex is second-order accurate. The mean stays where the fit is singular.
+  void recover_by_least_squares(const Vector& c) {
+    const Index n = mesh_.vertices.rows();
+    std::vector<std::vector<Index>> ring(n);
+    for (Index t = 0; t < mesh_.tetrahedra.rows(); ++t) {
+      for (int i = 0; i < 4; ++i) {
+        for (int j = 0; j < 4; ++j) {
+          if (i != j) ring[mesh_.tetrahedra(t, i)].push_back(mesh_.tetrahedra(t, j));
+        }
+      }
+    }
+    for (auto& r : ring) {
+      std::sort(r.begin(), r.end());
+      r.erase(std::unique(r.begin(), r.end()), r.end());
+    }
+    tbb::parallel_for(Index(0), n, [&](Index v) {
+      std::vector<Index> patch = ring[v];
+      if (patch.size() < 14) {
+        for (const Index w : ring[v]) patch.insert(patch.end(), ring[w].begin(), ring[w].end());
+        std::sort(patch.begin(), patch.end());
+        patch.erase(std::unique(patch.begin(), patch.end()), patch.end());
+        patch.erase(std::remove(patch.begin(), patch.end(), v), patch.end());
+      }
+      if (patch.size() < 12) return;
+      double h = 0.0;
+      for (const Index w : patch) h += (point(w) - point(v)).norm();
+      h /= static_cast<double>(patch.size());
+      Eigen::Matrix<double, 9, 9> normal_matrix = Eigen::Matrix<double, 9, 9>::Zero();
+      Eigen::Matrix<double, 9, 1> rhs = Eigen::Matrix<double, 9, 1>::Zero();
+      for (const Index w : patch) {
+        const Vec3 d = (point(w) - point(v)) / h;
+        const double weight = 1.0 / d.squaredNorm();
+        Eigen::Matrix<double, 9, 1> row;
+        row << d.x(), d.y(), d.z(), 0.5 * d.x() * d.x(), 0.5 * d.y() * d.y(), 0.5 * d.z() * d.z(), d.x() * d.y(),
+            d.y() * d.z(), d.z() * d.x();
+        normal_matrix += weight * row * row.transpose();
+        rhs += weight * (c[w] - c[v]) * row;
+      }
+      const Eigen::LDLT<Eigen::Matrix<double, 9, 9>> fit(normal_matrix);
+      if (fit.info() != Eigen::Success || !(fit.rcond() > 1e-10)) return;
+      const Eigen::Matrix<double, 9, 1> x = fit.solve(rhs);
+      if (!x.allFinite()) return;
+      velocity_[v] = -x.head<3>() / h;
+    });
+  }
+
+  Vec4 barycentric(Index t, const Vec3& x) const {
+    const Vec3 p0 = point(mesh_.tetrahedra(t, 0));
+    Eigen::Matrix3d edges;
+    for (int i = 0; i < 3; ++i) edges.col(i) = point(mesh_.tetrahedra(t, i + 1)) - p0;
+    const Vec3 l = edges.partialPivLu().solve(x - p0);
+    return Vec4(1.0 - l.sum(), l[0], l[1], l[2]);
+  }
+
+  // The tetrahedron containing x, walking from t towards it; the last one reached if x lies
+  // outside the mesh (the field is then extrapolated from there).
+  Index locate(Index t, const Vec3& x) const {
+    for (int k = 0; k < kWalkLimit; ++k) {
+      const Vec4 l = barycentric(t, x);
+      int i;
+      if (l.minCoeff(&i) >= -1e-12) return t;
+      const Index next = mesh_.neighbours(t, i);
+      if (next < 0) return t;
+      t = next;
+    }
+    return t;
+  }
+
+  Vec3 direction(Index t, const Vec3& x) const {
+    t = locate(t, x);
+    Vec3 u = element_flow_[t];
+    if (std::isnan(u.x())) {
+      const Vec4 l = barycentric(t, x);
+      u.setZero();
+      for (int i = 0; i < 4; ++i) u += l[i] * velocity_[mesh_.tetrahedra(t, i)];
+    }
+    const double norm = u.norm();
+    return norm > 0.0 ? Vec3(u / norm) : Vec3::Zero();
+  }
+
+  // Moves x along the straight segment to y, tetrahedron by tetrahedron. Sliding along a boundary
+  // that is not the target (the flow should not point into it but may, by a rounding of the
+  // recovered gradient near the source).
+  int walk(Index& t, Vec3& x, Vec3 y) const {
+    bool slid = false;
+    for (int k = 0; k < kWalkLimit; ++k) {
+      const Vec4 ly = barycentric(t, y);
+      if (ly.minCoeff() >= 0.0) {
+        x = y;
+        return inside;
+      }
+      const Vec4 lx = barycentric(t, x);
+      int face = -1;
+      double first = 2.0;
+      for (int i = 0; i < 4; ++i) {
+        if (ly[i] >= 0.0) continue;
+        const double a = std::max(lx[i], 0.0);
+        const double s = a / (a - ly[i]);
+        if (s < first || (s == first && face >= 0 && ly[i] < ly[face])) first = s, face = i;
+      }
+      const Vec3 p = x + first * (y - x);
+      const Index next = mesh_.neighbours(t, face);
+      if (next >= 0) {
+        t = next;
+        x = p;
+        continue;
+      }
+      x = p;
+      if (mesh_.patches(t, face) == detail::target_face) return reached_target;
+      if (slid) return inside;  // stop the step here
+      // Slide: the rest of the step projected onto the face's plane.
+      const Index a = mesh_.tetrahedra(t, (face + 1) % 4), b = mesh_.tetrahedra(t, (face + 2) % 4),
+                  d = mesh_.tetrahedra(t, (face + 3) % 4);
+      const Vec3 m = (point(b) - point(a)).cross(point(d) - point(a)).normalized();
+      y -= (y - p).dot(m) * m;
+      slid = true;
+    }
+    return lost_way;
+  }
+
+  const detail::ShellMesh& mesh_;
+  const Vector& c_;
+  std::vector<Vec3> velocity_;      // recovered -grad c at the vertices
+  std::vector<Vec3> element_flow_;  // -grad c of the tetrahedra at a crossing curve, else NaN
+  std::vector<double> step_;    // RK4 step length in each tetrahedron
+};
+
+// The source cleared of its contact with the target (contact3d.hpp), and how it then lies
+// against the target. Pulling back may make the source meet itself (a sliver of marching cubes
+// turned over, a neck narrower than the clearance): then again with half the clearance, down to
+// 1/32 of the edge (fuzz seed 5022 needed 1/16), before the contact is refused.
+struct Cleared {
+  detail::ClearedSource source;
+  detail::Nesting nesting;
+};
+
+Cleared clear_and_classify(const Points3Ref& source_vertices, const FacesRef& source_faces,
+                           const Points3Ref& target_vertices, const FacesRef& target_faces,
+                           const SurfaceIndex& target_index, double finer_edge, detail::Nesting nesting) {
+  double fraction = kClearanceFraction;
+  for (int attempt = 0;; ++attempt, fraction *= 0.5) {
+    Cleared cleared{detail::clear_contact(source_vertices, source_faces, target_vertices, target_faces, target_index,
+                                          fraction * finer_edge, kTouchFraction * finer_edge),
+                    nesting};
+    if (cleared.source.moved == 0) return cleared;
+    try {
+      cleared.nesting = detail::classify_nesting(cleared.source.vertices, source_faces, target_vertices, target_faces);
+      return cleared;
+    } catch (const InvalidInput&) {
+      if (attempt == kClearanceAttempts - 1) {
+        Index touching = 0;
+        for (const char t : cleared.source.touching) touching += t;
+        throw InvalidInput("s2: comes within " + std::to_string(fraction * finer_edge) + " of s1 over a patch (" +
+                           std::to_string(cleared.source.moved) + " vertices, " + std::to_string(touching) +
+                           " touching), and pulling s1 back from it there makes s1 intersect itself; diffusion "
+                           "cannot map these surfaces: use 'auto' (which falls back) or 'normal'");
+      }
+    }
+  }
+}
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, const FacesRef& source_faces,
+                                          const Points3Ref& target_vertices, const FacesRef& target_faces,
+                                          const ShellDiffusionOptions& options) {
+  if (!(options.mesh_size >= 0.0) || !std::isfinite(options.mesh_size)) {
+    detail::invalid("mesh_size", "must be a finite length >= 0");
+  }
+  const SurfaceFacts source = check_surface(source_vertices, source_faces, "s1");
+  const SurfaceFacts target = check_surface(target_vertices, target_faces, "s2");
+  // Mesh_3 and the nesting tests want outward orientation.
+  Faces source_out = source_faces, target_out = target_faces;
+  if (source.volume < 0.0) source_out.col(1).swap(source_out.col(2));
+  if (target.volume < 0.0) target_out.col(1).swap(target_out.col(2));
+
+  auto clock = std::chrono::steady_clock::now();
+  detail::Nesting nesting = detail::classify_nesting(source_vertices, source_out, target_vertices, target_out);
+  if (nesting == detail::Nesting::disjoint) {
+    throw InvalidInput("s2: diffusion mapping needs surfaces that overlap (these lie apart)");
+  }
+  const SurfaceIndex target_index(target_vertices, target_faces);
+  const double finer_edge = std::min(source.mean_edge, target.mean_edge);
+  const Cleared cleared_pair = clear_and_classify(source_vertices, source_out, target_vertices, target_out,
+                                                  target_index, finer_edge, nesting);
+  const detail::ClearedSource& cleared = cleared_pair.source;
+  nesting = cleared_pair.nesting;
+  // Bodies that only touch from outside count as crossing until the contact is cleared.
+  if (nesting == detail::Nesting::disjoint) {
+    throw InvalidInput("s2: only touches s1 from outside (the surfaces neither cross nor enclose one another); "
+                       "diffusion mapping needs surfaces that overlap");
+  }
+  // From here on the source is the cleared one: it bounds the region that is meshed and solved.
+  const Points3& source_region = cleared.vertices;
+  std::unique_ptr<detail::CrossingRegion> crossing;
+  if (nesting == detail::Nesting::crossing) {
+    crossing = std::make_unique<detail::CrossingRegion>(source_region, source_out, target_vertices, target_out);
+  }
+
+  // Sizes: the input spacing at each surface, growing by a tenth of the distance from it, never
+  // above mesh_size (default: a quarter of the mean gap, the region's volume over the mean area of
+  // the surfaces). Measured between spheres of radii 1 and 4: the end-point error falls about
+  // linearly with the element size in the bulk, and removing slivers (exude) buys more accuracy
+  // than it costs time.
+  const double volume = crossing ? crossing->volume() : std::abs(std::abs(target.volume) - std::abs(source.volume));
+  // Where the surfaces touch, they bound no region: leave that part out of the mean.
+  const double gap = volume / std::max(0.5 * (source.area + target.area) - cleared.near_area, 0.05 * source.area);
+  detail::ShellMeshCriteria criteria;
+  criteria.cell_size = options.mesh_size > 0.0 ? options.mesh_size : 0.25 * gap;
+  // Near the source, where the streamlines start, the elements stay within a fraction of the
+  // source's size however coarse its triangles are (the end error follows the element size
+  // there: concentric spheres r = 1 -> 4 with 642 vertices gave RMS 0.018 at the triangles' size).
+  const double source_diagonal = (source_vertices.colwise().maxCoeff() - source_vertices.colwise().minCoeff()).norm();
+  criteria.source_size = std::min({source.mean_edge, criteria.cell_size, kSourceFraction * source_diagonal});
+  criteria.target_size = std::min(target.mean_edge, criteria.cell_size);
+  criteria.grading = 0.1;
+  criteria.exude = true;
+  // Between nested surfaces the boundary facets may stray a fifth of the element size from the
+  // surfaces: at 0.05 Mesh_3 chased every crease of an unsmoothed marching-cubes surface (fuzz
+  // seed 1882337550, a 2k-vertex swell pair: 917k tetrahedra, 128 s; at 0.2: 265k, 15 s), while
+  // the concentric spheres' and the Figure 12 pair's accuracy stays (bench/README.md) and the
+  // folds its slivers cost are repaired. Where the surfaces cross, the pieces taper to wedges at
+  // the crossing curves and their facets must follow the surfaces closely (at 0.2 the round trip
+  // of the crossing pair grew from 2.4e-3 to 6.0e-3 RMS, and ends near the curve fell on the
+  // wrong side).
+  criteria.facet_distance = (crossing ? kFacetDistanceCrossing : kFacetDistanceNested) *
+                            std::min(criteria.source_size, criteria.target_size);
+  // In a child process (see mesh_in_child.hpp); after a crash, again with other random choices
+  // and sizes a little finer (the crashes come and go with both).
+  detail::ShellMesh mesh;
+  const detail::ShellMeshCriteria requested = criteria;
+  for (int attempt = 0;; ++attempt) {
+    const double finer = 1.0 - 0.15 * attempt;
+    criteria.seed = attempt;
+    criteria.cell_size = finer * requested.cell_size;
+    criteria.source_size = finer * requested.source_size;
+    criteria.target_size = finer * requested.target_size;
+    criteria.facet_distance = finer * requested.facet_distance;
+    try {
+      mesh = detail::mesh_in_child(
+          [&] {
+            return crossing ? crossing->mesh(criteria)
+                            : detail::mesh_shell(source_region, source_out, target_vertices, target_out,
+                                                 nesting == detail::Nesting::source_inside, criteria);
+          },
+          "meshing the region between the surfaces");
+      break;
+    } catch (const detail::MesherCrashed& crash) {
+      if (attempt + 1 == kMeshAttempts) {
+        throw GeometryError(std::string(crash.what()) + " in " + std::to_string(kMeshAttempts) +
+                            " attempts; try another mesh_size");
+      }
+    }
+  }
+
+  ShellDiffusionSolution solution;
+  solution.seconds.mesh = seconds_since(clock);
+  clock = std::chrono::steady_clock::now();
+
+  const Index nv = mesh.vertices.rows(), nt = mesh.tetrahedra.rows();
+  std::vector<char> kind(nv, free_vertex);
+  std::vector<Index> source_facets;  // tetrahedron * 4 + face
+  for (Index t = 0; t < nt; ++t) {
+    for (int i = 0; i < 4; ++i) {
+      const signed char patch = mesh.patches(t, i);
+      if (patch != detail::source_face && patch != detail::target_face) continue;
+      if (patch == detail::source_face) source_facets.push_back(4 * t + i);
+      for (int j = 1; j < 4; ++j) {
+        char& k = kind[mesh.tetrahedra(t, (i + j) % 4)];
+        const char here = patch == detail::source_face ? source_vertex : target_vertex;
+        k = k == free_vertex || k == here ? here : static_cast<char>(crossing_vertex);
+      }
+    }
+  }
+  if (source_facets.empty()) throw GeometryError("the mesh of the region has no face on s1");
+  solution.potential = solve_potential(mesh, kind);
+  solution.seconds.solve = seconds_since(clock);
+  clock = std::chrono::steady_clock::now();
+
+  // Start points: the closest point of the mesh's source boundary to each source vertex.
+  Faces facets(static_cast<Index>(source_facets.size()), 3);
+  for (std::size_t k = 0; k < source_facets.size(); ++k) {
+    const Index t = source_facets[k] / 4;
+    const int i = static_cast<int>(source_facets[k] % 4);
+    for (int j = 1; j < 4; ++j) facets(static_cast<Index>(k), j - 1) = mesh.tetrahedra(t, (i + j) % 4);
+  }
+  const detail::TriangleHits starts = detail::closest_on_triangles(mesh.vertices, facets, source_region);
+
+  const Tracer tracer(mesh, solution.potential, kind);
+  const Index ns = source_vertices.rows();
+  Points3 exits(ns, 3);
+  std::vector<std::vector<Vec3>> paths(options.keep_streamlines ? ns : 0);
+  tbb::parallel_for(Index(0), ns, [&](Index i) {
+    const Index t = source_facets[starts.faces[i]] / 4;
+    std::vector<Vec3>* path = options.keep_streamlines ? &paths[i] : nullptr;
+    if (path) path->push_back(source_vertices.row(i).transpose());
+    exits.row(i) = tracer.trace(t, starts.points.row(i).transpose(), path).transpose();
+  });
+
+  // The exit points lie on the mesh's approximation of the target: move them onto the surface.
+  std::vector<Index> reached;
+  for (Index i = 0; i < ns; ++i) {
+    if (exits.row(i).allFinite()) reached.push_back(i);
+  }
+  solution.ends = Points3::Constant(ns, 3, kNaN);
+  if (!reached.empty()) {
+    Points3 queries(static_cast<Index>(reached.size()), 3);
+    for (std::size_t k = 0; k < reached.size(); ++k) queries.row(static_cast<Index>(k)) = exits.row(reached[k]);
+    const SurfaceHits ends = target_index.closest_points(queries);
+    for (std::size_t k = 0; k < reached.size(); ++k) solution.ends.row(reached[k]) = ends.points.row(static_cast<Index>(k));
+  }
+  // Where the surfaces touch, the vertices map to their closest point (as 2D's contact stretches).
+  solution.touching.assign(cleared.touching.begin(), cleared.touching.end());
+  for (Index i = 0; i < ns; ++i) {
+    if (cleared.touching[i]) solution.ends.row(i) = cleared.closest.row(i);
+  }
+  if (options.keep_streamlines) {
+    solution.streamlines.resize(ns);
+    for (Index i = 0; i < ns; ++i) {
+      std::vector<Vec3>& path = paths[i];
+      path.push_back(solution.ends.row(i).transpose());
+      Points3 line(static_cast<Index>(path.size()), 3);
+      for (std::size_t k = 0; k < path.size(); ++k) line.row(static_cast<Index>(k)) = path[k].transpose();
+      solution.streamlines[i] = std::move(line);
+    }
+  }
+  solution.seconds.trace = seconds_since(clock);
+  solution.vertices = mesh.vertices;
+  solution.tetrahedra = mesh.tetrahedra;
+  return solution;
+}
+
+}  // namespace morphomap

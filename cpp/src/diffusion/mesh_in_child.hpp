@@ -1,0 +1,29 @@
+#pragma once
+// CGAL's Mesh_3 (5.5) can crash on valid input: on frames contoured from masks its refinement
+// segfaults in the triangulation's insert_in_hole (fuzz seeds 5002 and 5022, among others; the
+// same pair meshes at other element sizes). A crash there must not take the caller's process down,
+// so the mesh is made in a forked child and sent back through a pipe; a child that dies becomes a
+// GeometryError, and the caller may try again with other settings. The child runs the
+// single-threaded mesher only (no TBB, no Python, no Embree), allocating through glibc's malloc,
+// which its fork handlers leave usable however many threads the parent has.
+#include "diffusion/shell_mesh.hpp"
+
+#include <morphomap/errors.hpp>
+
+#include <functional>
+
+namespace morphomap::detail {
+
+// The child died (a signal): the caller may retry with other settings.
+class MesherCrashed : public GeometryError {
+ public:
+  using GeometryError::GeometryError;
+};
+
+// Runs `make` in a child process (where fork exists; else in this one) and returns its mesh. Its
+// InvalidInput and GeometryError come back as such; a child killed by a signal gives a
+// MesherCrashed naming `what` and the signal. Polls check_interrupt while it waits (the child is
+// then killed).
+ShellMesh mesh_in_child(const std::function<ShellMesh()>& make, const char* what);
+
+}  // namespace morphomap::detail

@@ -1,0 +1,403 @@
+// The only translation unit with CGAL's 3D mesher (it compiles slowly): the region between two
+// closed surfaces, meshed as a polyhedral complex whose patches separate it (subdomains 1 and 2)
+// from the rest of space (subdomain 0). Nested surfaces give one shell with two patches; crossing
+// surfaces are first cut where they cross.
+#include "diffusion/shell_mesh.hpp"
+
+#include "surfaces/surface_mesh.hpp"
+
+#include <morphomap/errors.hpp>
+
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Mesh_complex_3_in_triangulation_3.h>
+#include <CGAL/Mesh_criteria_3.h>
+#include <CGAL/Mesh_triangulation_3.h>
+#include <CGAL/Polygon_mesh_processing/connected_components.h>
+#include <CGAL/Polygon_mesh_processing/corefinement.h>
+#include <CGAL/Polygon_mesh_processing/intersection.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/make_mesh_3.h>
+#include <CGAL/Polyhedral_complex_mesh_domain_3.h>
+#include <CGAL/Orthogonal_k_neighbor_search.h>
+#include <CGAL/Random.h>
+#include <CGAL/Search_traits_3.h>
+#include <CGAL/Side_of_triangle_mesh.h>
+#include <CGAL/Surface_mesh.h>
+#include <CGAL/boost/graph/properties_Surface_mesh_features.h>
+#include <CGAL/refine_mesh_3.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace morphomap::detail {
+
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = Kernel::Point_3;
+using Domain = CGAL::Polyhedral_complex_mesh_domain_3<Kernel, SurfaceMesh>;
+using Triangulation = CGAL::Mesh_triangulation_3<Domain, CGAL::Default, CGAL::Sequential_tag>::type;
+using C3t3 = CGAL::Mesh_complex_3_in_triangulation_3<Triangulation, Domain::Corner_index, Domain::Curve_index>;
+using Criteria = CGAL::Mesh_criteria_3<Triangulation>;
+
+using SearchTraits = CGAL::Search_traits_3<Kernel>;
+using Neighbour = CGAL::Orthogonal_k_neighbor_search<SearchTraits>;
+using PointTree = Neighbour::Tree;
+using Triangles = std::vector<Kernel::Triangle_3>;
+using SoupTree =
+    CGAL::AABB_tree<CGAL::AABB_traits<Kernel, CGAL::AABB_triangle_primitive<Kernel, Triangles::const_iterator>>>;
+
+// Target edge length at a point: graded from the size at each surface with the distance to it,
+// the distance estimated by the nearest surface vertex (cheap: Mesh_3 asks very often). Mesh_3
+// copies its sizing fields: the trees are shared.
+class Sizing {
+ public:
+  Sizing(const SurfaceMesh& source, const SurfaceMesh& target, const ShellMeshCriteria& criteria)
+      : source_(std::make_shared<PointTree>(source.points().begin(), source.points().end())),
+        target_(std::make_shared<PointTree>(target.points().begin(), target.points().end())),
+        criteria_(criteria) {
+    source_->build();
+    target_->build();
+  }
+
+  template <typename Index_>
+  double operator()(const Point& p, int, const Index_&) const {
+    const double ds = std::sqrt(Neighbour(*source_, p, 1).begin()->second);
+    const double dt = std::sqrt(Neighbour(*target_, p, 1).begin()->second);
+    return std::min({criteria_.cell_size, criteria_.source_size + criteria_.grading * ds,
+                     criteria_.target_size + criteria_.grading * dt});
+  }
+
+ private:
+  std::shared_ptr<PointTree> source_, target_;
+  ShellMeshCriteria criteria_;
+};
+
+// A few vertices of a surface (every n/20-th) inserted as points of its patch.
+void seed_patch(C3t3& c3t3, const Domain& domain, const SurfaceMesh& surface, int patch) {
+  Triangulation& tr = c3t3.triangulation();
+  const auto weighted = tr.geom_traits().construct_weighted_point_3_object();
+  const std::size_t n = surface.number_of_vertices(), stride = std::max<std::size_t>(1, n / 20);
+  std::size_t k = 0;
+  for (const auto v : surface.vertices()) {
+    if (k++ % stride != 0) continue;
+    const auto handle = tr.insert(weighted(surface.point(v)));
+    if (handle == Triangulation::Vertex_handle()) continue;
+    c3t3.set_dimension(handle, 2);
+    c3t3.set_index(handle, domain.index_from_surface_patch_index(patch));
+  }
+}
+
+// Delaunay refinement of the complex to the criteria (no perturbation), then optionally exudation
+// of slivers.
+void refine(C3t3& c3t3, const Domain& domain, const Criteria& criteria, bool exude) {
+  namespace params = CGAL::parameters;
+  if (exude) {
+    CGAL::refine_mesh_3(c3t3, domain, criteria, params::no_perturb(), params::exude());
+  } else {
+    CGAL::refine_mesh_3(c3t3, domain, criteria, params::no_perturb(), params::no_exude());
+  }
+}
+
+// The tetrahedra of the complex, with their neighbours and the kind of each boundary face:
+// patch_kind(patch index) -> FacePatch.
+template <class PatchKind>
+ShellMesh to_shell_mesh(const C3t3& c3t3, PatchKind patch_kind) {
+  ShellMesh mesh;
+  const Triangulation& tr = c3t3.triangulation();
+  std::unordered_map<Triangulation::Cell_handle, Index> cell_index;
+  std::unordered_map<Triangulation::Vertex_handle, Index> vertex_index;
+  Index cells = 0;
+  for (auto c = c3t3.cells_in_complex_begin(); c != c3t3.cells_in_complex_end(); ++c) {
+    cell_index[c] = cells++;
+    for (int i = 0; i < 4; ++i) vertex_index.emplace(c->vertex(i), static_cast<Index>(vertex_index.size()));
+  }
+  if (cells == 0) throw GeometryError("meshing the region between the surfaces gave no tetrahedra");
+  mesh.vertices.resize(static_cast<Index>(vertex_index.size()), 3);
+  for (const auto& [v, k] : vertex_index) {
+    const Point p = tr.geom_traits().construct_point_3_object()(v->point());
+    mesh.vertices.row(k) << p.x(), p.y(), p.z();
+  }
+  mesh.tetrahedra.resize(cells, 4);
+  mesh.neighbours.resize(cells, 4);
+  mesh.patches.resize(cells, 4);
+  for (const auto& [c, t] : cell_index) {
+    for (int i = 0; i < 4; ++i) {
+      mesh.tetrahedra(t, i) = vertex_index.at(c->vertex(i));
+      const auto across = cell_index.find(c->neighbor(i));
+      if (across != cell_index.end()) {
+        mesh.neighbours(t, i) = across->second;
+        mesh.patches(t, i) = interior_face;
+      } else {
+        mesh.neighbours(t, i) = -1;
+        const int patch = c3t3.is_in_complex(c, i) ? static_cast<int>(c3t3.surface_patch_index(c, i)) : -1;
+        mesh.patches(t, i) = patch_kind(patch);
+      }
+    }
+  }
+  return mesh;
+}
+
+}  // namespace
+
+namespace {
+constexpr const char* kSelfIntersecting =
+    "intersects itself; the mapping needs a simple closed surface (a mask contoured without "
+    "smoothing can touch itself at a voxel edge: smooth or remesh it)";
+}  // namespace
+
+Nesting classify_nesting(const Points3Ref& source_vertices, const FacesRef& source_faces,
+                         const Points3Ref& target_vertices, const FacesRef& target_faces) {
+  try {
+    const SurfaceMesh source = to_surface_mesh(source_vertices, source_faces);
+    const SurfaceMesh target = to_surface_mesh(target_vertices, target_faces);
+    // Mesh_3 on a self-intersecting surface may crash rather than fail.
+    if (CGAL::Polygon_mesh_processing::does_self_intersect(source)) {
+      throw InvalidInput(std::string("s1: ") + kSelfIntersecting);
+    }
+    if (CGAL::Polygon_mesh_processing::does_self_intersect(target)) {
+      throw InvalidInput(std::string("s2: ") + kSelfIntersecting);
+    }
+    if (CGAL::Polygon_mesh_processing::do_intersect(source, target)) return Nesting::crossing;
+    const CGAL::Side_of_triangle_mesh<SurfaceMesh, Kernel> in_target(target), in_source(source);
+    const Point s = source.point(*source.vertices().begin());
+    const Point t = target.point(*target.vertices().begin());
+    if (in_target(s) == CGAL::ON_BOUNDED_SIDE) return Nesting::source_inside;
+    if (in_source(t) == CGAL::ON_BOUNDED_SIDE) return Nesting::target_inside;
+    return Nesting::disjoint;
+  } catch (const CGAL::Failure_exception& e) {
+    throw GeometryError(std::string("comparing the two surfaces failed: ") + e.what());
+  }
+}
+
+std::vector<char> inside_surface(const Points3Ref& vertices, const FacesRef& faces, const Points3Ref& queries) {
+  std::vector<char> inside(static_cast<std::size_t>(queries.rows()), 0);
+  try {
+    const SurfaceMesh surface = to_surface_mesh(vertices, faces);
+    const CGAL::Side_of_triangle_mesh<SurfaceMesh, Kernel> side(surface);
+    for (Index i = 0; i < queries.rows(); ++i) {
+      inside[static_cast<std::size_t>(i)] = side(Point(queries(i, 0), queries(i, 1), queries(i, 2))) != CGAL::ON_UNBOUNDED_SIDE;
+    }
+  } catch (const CGAL::Failure_exception& e) {
+    throw GeometryError(std::string("locating points against a surface failed: ") + e.what());
+  }
+  return inside;
+}
+
+ShellMesh mesh_shell(const Points3Ref& source_vertices, const FacesRef& source_faces,
+                     const Points3Ref& target_vertices, const FacesRef& target_faces, bool source_inside,
+                     const ShellMeshCriteria& criteria) {
+  C3t3 c3t3;
+  try {
+    std::vector<SurfaceMesh> patches{to_surface_mesh(source_vertices, source_faces),
+                                     to_surface_mesh(target_vertices, target_faces)};
+    // (subdomain inside, subdomain outside) of each outward-oriented patch; the shell is 1.
+    const std::pair<int, int> inner(0, 1), outer(1, 0);
+    const std::pair<int, int> sides[2] = {source_inside ? inner : outer, source_inside ? outer : inner};
+    const Sizing sizing(patches[0], patches[1], criteria);
+    CGAL::Random random(criteria.seed);
+    const Domain domain(patches.begin(), patches.end(), sides, sides + 2, &random);
+    namespace params = CGAL::parameters;
+    const Criteria mesh_criteria(params::facet_angle = 25.0, params::facet_size = sizing,
+                                 params::facet_distance = criteria.facet_distance,
+                                 params::cell_radius_edge_ratio = 3.0, params::cell_size = sizing);
+    // Mesh_3's own initial points come from rays shot from the centre of the bounding box and may
+    // all land on the outer surface, so that the inner one is never found: start instead from a
+    // few vertices of each surface, as points of its patch.
+    // (Asking for the construction object makes the domain detect its borders, as make_mesh_3 would.)
+    (void)domain.construct_initial_points_object();
+    for (int patch = 1; patch <= 2; ++patch) seed_patch(c3t3, domain, patches[patch - 1], patch);
+    refine(c3t3, domain, mesh_criteria, criteria.exude);
+  } catch (const CGAL::Failure_exception& e) {
+    throw GeometryError(std::string("meshing the region between the surfaces failed: ") + e.what());
+  }
+
+  return to_shell_mesh(c3t3, [](int patch) {
+    return patch == 1 ? source_face : patch == 2 ? target_face : other_face;
+  });
+}
+
+// Each patch: a connected piece of one surface between the curves where the surfaces cross,
+// oriented outwards of its surface.
+struct CrossingRegion::Patches {
+  SurfaceMesh source, target;        // the whole surfaces (for the sizing field)
+  std::vector<SurfaceMesh> meshes;   // the patches
+  std::vector<char> from_source;     // the patch is part of S1 (else of S2)
+  std::vector<char> inside_other;    // it lies inside the other surface
+  std::vector<char> has_border;      // it ends at a crossing curve (a patch without one is a
+                                     // whole component of a surface that the other does not cut)
+  double volume = 0.0;
+};
+
+namespace {
+
+// The faces of each connected component of mesh, bounded by the constrained edges, as meshes.
+template <class ConstrainedMap>
+std::vector<SurfaceMesh> split_along(SurfaceMesh& mesh, const ConstrainedMap& constrained,
+                                     std::vector<char>& has_border) {
+  namespace PMP = CGAL::Polygon_mesh_processing;
+  auto component = mesh.add_property_map<SurfaceMesh::Face_index, std::size_t>("f:component", 0).first;
+  const std::size_t count =
+      PMP::connected_components(mesh, component, CGAL::parameters::edge_is_constrained_map(constrained));
+  std::vector<SurfaceMesh> parts(count);
+  std::vector<std::unordered_map<std::size_t, SurfaceMesh::Vertex_index>> handle(count);
+  std::vector<char> border(count, 0);
+  for (const auto f : mesh.faces()) {
+    const std::size_t k = component[f];
+    std::array<SurfaceMesh::Vertex_index, 3> corner;
+    int i = 0;
+    for (const auto h : CGAL::halfedges_around_face(mesh.halfedge(f), mesh)) {
+      const auto v = mesh.target(h);
+      const auto [it, added] = handle[k].emplace(std::size_t(v), SurfaceMesh::Vertex_index());
+      if (added) it->second = parts[k].add_vertex(mesh.point(v));
+      corner[i++] = it->second;
+      if (constrained[mesh.edge(h)]) border[k] = 1;
+    }
+    parts[k].add_face(corner[0], corner[1], corner[2]);
+  }
+  has_border.insert(has_border.end(), border.begin(), border.end());
+  return parts;
+}
+
+// Signed volume enclosed with the origin o (positive for faces seen anticlockwise from outside).
+double signed_volume(const SurfaceMesh& mesh, const Point& o) {
+  double volume = 0.0;
+  for (const auto f : mesh.faces()) {
+    std::array<Kernel::Vector_3, 3> p;
+    int i = 0;
+    for (const auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) p[i++] = mesh.point(v) - o;
+    volume += CGAL::scalar_product(p[0], CGAL::cross_product(p[1], p[2])) / 6.0;
+  }
+  return volume;
+}
+
+}  // namespace
+
+CrossingRegion::CrossingRegion(const Points3Ref& source_vertices, const FacesRef& source_faces,
+                               const Points3Ref& target_vertices, const FacesRef& target_faces)
+    : patches_(std::make_unique<Patches>()) {
+  namespace PMP = CGAL::Polygon_mesh_processing;
+  Patches& p = *patches_;
+  try {
+    p.source = to_surface_mesh(source_vertices, source_faces);
+    p.target = to_surface_mesh(target_vertices, target_faces);
+    SurfaceMesh source = p.source, target = p.target;
+    auto source_cut = source.add_property_map<SurfaceMesh::Edge_index, bool>("e:cut", false).first;
+    auto target_cut = target.add_property_map<SurfaceMesh::Edge_index, bool>("e:cut", false).first;
+    PMP::corefine(source, target, CGAL::parameters::edge_is_constrained_map(source_cut),
+                  CGAL::parameters::edge_is_constrained_map(target_cut));
+    p.meshes = split_along(source, source_cut, p.has_border);
+    p.from_source.assign(p.meshes.size(), 1);
+    for (auto& part : split_along(target, target_cut, p.has_border)) p.meshes.push_back(std::move(part));
+    p.from_source.resize(p.meshes.size(), 0);
+
+    // Inside or outside the other surface: the side of the centroid of the patch's largest face.
+    const CGAL::Side_of_triangle_mesh<SurfaceMesh, Kernel> in_source(p.source), in_target(p.target);
+    for (std::size_t k = 0; k < p.meshes.size(); ++k) {
+      const SurfaceMesh& mesh = p.meshes[k];
+      Point centroid;
+      double largest = -1.0;
+      for (const auto f : mesh.faces()) {
+        std::array<Point, 3> q;
+        int i = 0;
+        for (const auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) q[i++] = mesh.point(v);
+        const double area = CGAL::squared_area(q[0], q[1], q[2]);
+        if (area > largest) largest = area, centroid = CGAL::centroid(q[0], q[1], q[2]);
+      }
+      const CGAL::Bounded_side side = p.from_source[k] ? in_target(centroid) : in_source(centroid);
+      if (side == CGAL::ON_BOUNDARY) {
+        throw InvalidInput("s2: coincides with s1 over a patch; the region between them is not a volume there");
+      }
+      p.inside_other.push_back(side == CGAL::ON_BOUNDED_SIDE ? 1 : 0);
+    }
+  } catch (const CGAL::Failure_exception& e) {
+    throw GeometryError(std::string("cutting the surfaces where they cross failed: ") + e.what());
+  }
+
+  // S1 \ S2 is bounded by the parts of S1 outside S2 (outwards) and of S2 inside S1 (inwards),
+  // S2 \ S1 likewise: the pieces' volume is the sum over the outside patches minus the inside ones.
+  const Point origin = CGAL::centroid(p.source.points().begin(), p.source.points().end());
+  for (std::size_t k = 0; k < p.meshes.size(); ++k) {
+    const double volume = signed_volume(p.meshes[k], origin);
+    p.volume += p.inside_other[k] ? -volume : volume;
+  }
+}
+
+CrossingRegion::~CrossingRegion() = default;
+
+double CrossingRegion::volume() const { return patches_->volume; }
+
+ShellMesh CrossingRegion::mesh(const ShellMeshCriteria& criteria) const {
+  const Patches& p = *patches_;
+  C3t3 c3t3;
+  try {
+    // (subdomain inside, subdomain outside) of each patch: S1 \ S2 is 1, S2 \ S1 is 2, the
+    // intersection and the outside of both are 0 (not meshed).
+    std::vector<std::pair<int, int>> sides;
+    for (std::size_t k = 0; k < p.meshes.size(); ++k) {
+      const int piece_inside = p.from_source[k] ? 1 : 2, piece_outside = p.from_source[k] ? 2 : 1;
+      sides.push_back(p.inside_other[k] ? std::make_pair(0, piece_outside) : std::make_pair(piece_inside, 0));
+    }
+    const Sizing sizing(p.source, p.target, criteria);
+    CGAL::Random random(criteria.seed);
+    const Domain domain(p.meshes.begin(), p.meshes.end(), sides.begin(), sides.end(), &random);
+    namespace params = CGAL::parameters;
+    // First the crossing curves, protected by balls of the local size, and a coarse mesh; then
+    // the few vertices of any patch no curve bounds (Mesh_3 may not find it by itself); then the
+    // refinement to the real criteria.
+    const Criteria coarse(params::edge_size = sizing, params::facet_angle = 25.0,
+                          params::facet_size = criteria.cell_size, params::cell_radius_edge_ratio = 3.0,
+                          params::cell_size = criteria.cell_size);
+    c3t3 = CGAL::make_mesh_3<C3t3>(domain, coarse, params::features(domain), params::no_perturb(),
+                                   params::no_exude());
+    for (std::size_t k = 0; k < p.meshes.size(); ++k) {
+      if (!p.has_border[k]) seed_patch(c3t3, domain, p.meshes[k], static_cast<int>(k) + 1);
+    }
+    const Criteria fine(params::edge_size = sizing, params::facet_angle = 25.0, params::facet_size = sizing,
+                        params::facet_distance = criteria.facet_distance, params::cell_radius_edge_ratio = 3.0,
+                        params::cell_size = sizing);
+    refine(c3t3, domain, fine, criteria.exude);
+  } catch (const CGAL::Failure_exception& e) {
+    throw GeometryError(std::string("meshing the region between the surfaces failed: ") + e.what());
+  }
+  const int count = static_cast<int>(p.meshes.size());
+  return to_shell_mesh(c3t3, [&](int patch) {
+    if (patch < 1 || patch > count) return other_face;
+    return p.from_source[patch - 1] ? source_face : target_face;
+  });
+}
+
+TriangleHits closest_on_triangles(const Points3Ref& vertices, const FacesRef& faces, const Points3Ref& queries) {
+  Triangles triangles;
+  triangles.reserve(faces.rows());
+  auto point = [&](Index v) { return Point(vertices(v, 0), vertices(v, 1), vertices(v, 2)); };
+  for (Index f = 0; f < faces.rows(); ++f) {
+    triangles.emplace_back(point(faces(f, 0)), point(faces(f, 1)), point(faces(f, 2)));
+  }
+  TriangleHits hits;
+  hits.points.resize(queries.rows(), 3);
+  hits.faces.resize(queries.rows());
+  try {
+    SoupTree tree(triangles.cbegin(), triangles.cend());
+    tree.accelerate_distance_queries();
+    tbb::parallel_for(Index(0), Index(queries.rows()), [&](Index i) {
+      const auto [p, id] = tree.closest_point_and_primitive(Point(queries(i, 0), queries(i, 1), queries(i, 2)));
+      hits.points.row(i) << p.x(), p.y(), p.z();
+      hits.faces[i] = static_cast<Index>(id - triangles.cbegin());
+    });
+  } catch (const CGAL::Failure_exception& e) {
+    throw GeometryError(std::string("closest points on a surface failed: ") + e.what());
+  }
+  return hits;
+}
+
+}  // namespace morphomap::detail

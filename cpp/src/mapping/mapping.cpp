@@ -1,0 +1,677 @@
+// The paper's 2D mapping: basic algorithms (minimal distance, normal, uniform) on a source curve
+// and a target curve, or on each pair of segments between their intersection points (split), with
+// the reverse and transform extensions around them.
+#include <morphomap/curve_geometry.hpp>
+#include <morphomap/crossings.hpp>
+#include <morphomap/curve_queries.hpp>
+#include <morphomap/laplace.hpp>
+#include <morphomap/mapping.hpp>
+#include <morphomap/optimal.hpp>
+#include <morphomap/resample.hpp>
+#include <morphomap/transform.hpp>
+
+#include "common/finite_rows.hpp"
+#include "common/interrupt_check.hpp"
+#include "common/numbers.hpp"
+#include "common/validation.hpp"
+#include "curves/arc_curve.hpp"
+#include "curves/contact.hpp"
+#include "curves/inside.hpp"
+
+#include <unsupported/Eigen/FFT>
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <limits>
+#include <vector>
+
+namespace morphomap {
+
+using detail::kNaN;
+
+std::string method_name(Method method) {
+  switch (method) {
+    case Method::minimal_distance: return "minimal_distance";
+    case Method::normal: return "normal";
+    case Method::diffusion: return "diffusion";
+    case Method::uniform: return "uniform";
+    case Method::reverse_minimal_distance: return "reverse_minimal_distance";
+    case Method::reverse_normal: return "reverse_normal";
+    case Method::reverse_diffusion: return "reverse_diffusion";
+    case Method::reverse_uniform: return "reverse_uniform";
+    case Method::optimal: return "optimal";
+    case Method::reverse_optimal: return "reverse_optimal";
+  }
+  return "unknown";
+}
+
+Method reversed(Method method) {
+  switch (method) {
+    case Method::optimal: return Method::reverse_optimal;
+    case Method::reverse_optimal: return Method::optimal;
+    default: break;
+  }
+  const int code = static_cast<int>(method);
+  return static_cast<Method>(code < 4 ? code + 4 : code - 4);
+}
+
+namespace {
+
+using detail::ArcCurve;
+using detail::Meeting;
+
+// A piece of the source (the whole curve, or the stretch between two crossings) with its start
+// points, and the piece of the target it maps onto.
+struct Job {
+  Points2 source;                // the source polyline
+  bool source_closed = false;
+  std::vector<Index> start_rows;  // rows of source that are start points, in order along it
+  Points2 normals;               // normal mapping: the normal of the whole curve at each start
+  Vector fractions;              // uniform: arc position along the source / its length
+  Points2 target;
+  bool target_closed = false;
+  // The first / last rows of source and target are the two ends of a meeting (a crossing or a
+  // contact stretch), whose own vectors map them: no start point there, either way round.
+  bool shared_begin = false, shared_end = false;
+  double anchor = 0.0;           // uniform: target arc position where fraction 0 lands
+  int direction = 1;             // uniform: +1 forward along the target, -1 backward
+};
+
+// Vectors with the arc position of their start along the whole source curve, to order them.
+struct Vectors {
+  Points2 starts, ends;
+  std::vector<Method> methods;
+  std::vector<double> keys;
+};
+
+Points2 start_points(const Job& job) {
+  Points2 starts(job.start_rows.size(), 2);
+  for (std::size_t j = 0; j < job.start_rows.size(); ++j) starts.row(j) = job.source.row(job.start_rows[j]);
+  return starts;
+}
+
+// What every job of one mapping shares.
+struct Settings {
+  double density_threshold = 0.0;
+  double contact_tolerance = -1.0;  // < 0: default_contact_tolerance
+  DiffusionOptions diffusion;
+  double stretch_weight = kDefaultStretchWeight;  // "optimal"
+};
+
+bool all_rows_equal(const Points2& points) {
+  for (Index i = 1; i < points.rows(); ++i) {
+    if (points.row(i) != points.row(0)) return false;
+  }
+  return true;
+}
+
+// Streamlines of one flow do not cross, but two that run a hair apart can come out swapped by
+// rounding and step error (seen where they converge onto a small curve): the ends, taken in the
+// order of their start points, are put back in order along the target, the set of ends kept.
+// Positions are unrolled step by step (the shorter way between neighbours on a closed curve), so
+// only local swaps move.
+void put_in_order(Points2& ends, const ArcCurve& target) {
+  const std::vector<Index> rows = detail::finite_rows(ends);
+  if (rows.size() < 2) return;
+  const Points2 found = ends(rows, Eigen::all);
+  const Vector arcs = CurveIndex(target.points(), target.closed()).closest_points(found).arc_lengths;
+  const double length = target.length();
+  std::vector<double> unrolled(rows.size(), 0.0);
+  for (std::size_t k = 1; k < rows.size(); ++k) {
+    double step = arcs[k] - arcs[k - 1];
+    if (target.closed()) step -= length * std::round(step / length);
+    unrolled[k] = unrolled[k - 1] + step;
+  }
+  const double direction = unrolled.back() >= 0.0 ? 1.0 : -1.0;
+  for (double& u : unrolled) u *= direction;
+  if (std::is_sorted(unrolled.begin(), unrolled.end())) return;
+  std::sort(unrolled.begin(), unrolled.end());
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    ends.row(rows[k]) = target.point_at(arcs[0] + direction * unrolled[k]).transpose();
+  }
+}
+
+double best_anchor(const ArcCurve& source, const ArcCurve& target, int direction);
+int relative_direction(const ArcCurve& source, const ArcCurve& target);
+
+// A closed curve cut open at arc position a: from the point there once round back to it.
+Points2 cut_open(const ArcCurve& curve, double a) {
+  a = curve.wrap(a);
+  std::vector<Vec2> rows{curve.point_at(a)};
+  for (Index v = 0; v < curve.size(); ++v) {
+    if (curve.arc(v) > a) rows.push_back(curve.points().row(v).transpose());
+  }
+  for (Index v = 0; v < curve.size(); ++v) {
+    if (curve.arc(v) < a) rows.push_back(curve.points().row(v).transpose());
+  }
+  rows.push_back(rows.front());
+  Points2 out(rows.size(), 2);
+  for (std::size_t r = 0; r < rows.size(); ++r) out.row(r) = rows[r].transpose();
+  return out;
+}
+
+// best_anchor's shift to within a hair: it is found on a grid of m samples, and a pinned start
+// point that is off by a fraction of a sample turns the whole matching by that much. Golden-section
+// search of the same sum of squared displacements over one grid step either side.
+double refined_anchor(const ArcCurve& source, const ArcCurve& target, double anchor) {
+  Index m = 64;
+  while (m < 2 * source.size()) m *= 2;
+  std::vector<Vec2> s(m);
+  for (Index j = 0; j < m; ++j) s[j] = source.point_at(source.length() * j / m);
+  auto cost = [&](double a) {
+    double sum = 0.0;
+    for (Index j = 0; j < m; ++j) sum += (s[j] - target.point_at(a + target.length() * j / m)).squaredNorm();
+    return sum;
+  };
+  const double ratio = 0.5 * (std::sqrt(5.0) - 1.0), bin = target.length() / m;
+  double lo = anchor - bin, hi = anchor + bin;
+  double x1 = hi - ratio * (hi - lo), x2 = lo + ratio * (hi - lo), f1 = cost(x1), f2 = cost(x2);
+  for (int iteration = 0; iteration < 20; ++iteration) {  // 0.618^20: 1e-4 of a step
+    if (f1 < f2) {
+      hi = x2, x2 = x1, f2 = f1, x1 = hi - ratio * (hi - lo), f1 = cost(x1);
+    } else {
+      lo = x1, x1 = x2, f1 = f2, x2 = lo + ratio * (hi - lo), f2 = cost(x2);
+    }
+  }
+  const double best = 0.5 * (lo + hi);
+  return cost(best) <= cost(anchor) ? best : anchor;
+}
+
+// "optimal" on one job. A piece (or open curves) is matched between its two ends. Whole closed
+// curves are cut open at the first start point and at the point of the target that the best
+// cyclic shift puts there (best_anchor), matched once round, then cut again at the start point
+// half way round and where the first matching took it, and matched again, so that the pinned
+// point of the first pass is free in the second; the lower energy wins.
+Points2 optimal_ends(const Job& job, double stretch_weight) {
+  if (!job.source_closed) return monotone_match(job.source, job.start_rows, job.target, stretch_weight).points;
+  const ArcCurve source(job.source, true, "c1");
+  const ArcCurve given(job.target, true, "c2");
+  const ArcCurve target(relative_direction(source, given) > 0 ? given.points() : Points2(given.points().colwise().reverse()),
+                        true, "c2");
+  const Index n = source.size();
+  const Index count = static_cast<Index>(job.start_rows.size());
+  auto pass = [&](Index first, double anchor, MonotoneMatch& match) {
+    const Index h = job.start_rows[first];
+    Points2 rotated(n + 1, 2);
+    for (Index j = 0; j <= n; ++j) rotated.row(j) = source.points().row((h + j) % n);
+    std::vector<Index> rows(count);
+    for (Index k = 0; k < count; ++k) rows[k] = (job.start_rows[(first + k) % count] - h + n) % n;
+    match = monotone_match(rotated, rows, cut_open(target, anchor), stretch_weight);
+    Points2 ends(count, 2);
+    for (Index k = 0; k < count; ++k) ends.row((first + k) % count) = match.points.row(k);
+    return ends;
+  };
+  MonotoneMatch first, second;
+  const double anchor = refined_anchor(source, target, best_anchor(source, target, 1)) +
+                        source.arc(job.start_rows[0]) * target.length() / source.length();
+  Points2 ends = pass(0, anchor, first);
+  if (count < 2) return ends;
+  const Index half = count / 2;
+  Points2 other = pass(half, anchor + first.arcs[half], second);
+  return second.energy < first.energy ? other : ends;
+}
+
+Points2 basic_ends(MapMethod method, const Job& job, const Points2& starts, const Settings& settings) {
+  if (starts.rows() == 0) return Points2(0, 2);
+  // A piece of the target that shrank to a point (two meetings at one place) takes all starts.
+  if (all_rows_equal(job.target)) return job.target.row(0).replicate(starts.rows(), 1);
+  const ArcCurve target(job.target, job.target_closed, "c2");
+  switch (method) {
+    case MapMethod::minimal_distance:
+      return CurveIndex(job.target, job.target_closed).closest_points(starts).points;
+    case MapMethod::normal:
+      return CurveIndex(job.target, job.target_closed).line_intersections(starts, job.normals).points;
+    case MapMethod::uniform: {
+      Points2 ends(starts.rows(), 2);
+      for (Index i = 0; i < ends.rows(); ++i) {
+        const double s = job.anchor + job.direction * job.fractions[i] * target.length();
+        ends.row(i) = target.point_at(s).transpose();
+      }
+      return ends;
+    }
+    case MapMethod::diffusion: {
+      const DiffusionSolution solution = solve_diffusion(job.source, job.target, job.source_closed, settings.diffusion);
+      Points2 ends(starts.rows(), 2);
+      for (std::size_t j = 0; j < job.start_rows.size(); ++j) ends.row(j) = solution.ends.row(job.start_rows[j]);
+      put_in_order(ends, target);
+      return ends;
+    }
+    case MapMethod::optimal:
+      return optimal_ends(job, settings.stretch_weight);
+    case MapMethod::automatic:
+      break;
+  }
+  detail::invalid("method", "not a basic algorithm");
+}
+
+Method basic_method(MapMethod method) {
+  switch (method) {
+    case MapMethod::minimal_distance: return Method::minimal_distance;
+    case MapMethod::optimal: return Method::optimal;
+    case MapMethod::normal: return Method::normal;
+    case MapMethod::uniform: return Method::uniform;
+    case MapMethod::diffusion: return Method::diffusion;
+    case MapMethod::automatic: break;
+  }
+  detail::invalid("method", "'auto' is not a basic algorithm");
+}
+
+// Start points per gap: the mean distance from the starts to the target over their mean spacing
+// along the source.
+double point_density(const Job& job, const Points2& starts) {
+  const double gap = CurveIndex(job.target, job.target_closed).closest_points(starts).distances.mean();
+  const double spacing = ArcCurve(job.source, job.source_closed, "c1").length() / starts.rows();
+  return spacing > 0.0 ? gap / spacing : 0.0;
+}
+
+// A basic algorithm on one job, from its start points.
+Vectors forward(MapMethod method, const Job& job, const std::vector<double>& start_keys, const Settings& settings) {
+  Vectors v;
+  v.starts = start_points(job);
+  v.keys = start_keys;
+  v.ends = basic_ends(method, job, v.starts, settings);
+  v.methods.assign(v.starts.rows(), basic_method(method));
+  return v;
+}
+
+// A basic algorithm run backwards on one job (the paper's reverse mapping): from the target's
+// points (but shared crossings) to the source, flipped.
+Vectors reverse(MapMethod method, const Job& job, const ArcCurve& whole_source, const Settings& settings) {
+  Job back;
+  back.source = job.target;
+  back.source_closed = job.target_closed;
+  back.target = job.source;
+  back.target_closed = job.source_closed;
+  const Index n = job.target.rows();
+  for (Index i = 0; i < n; ++i) {
+    const bool shared =
+        !job.target_closed && ((i == 0 && (job.shared_begin || job.target.row(0) == job.source.row(0))) ||
+                               (i == n - 1 && (job.shared_end || job.target.row(n - 1) == job.source.row(job.source.rows() - 1))));
+    if (!shared) back.start_rows.push_back(i);
+  }
+  Vectors v;
+  v.ends = start_points(back);
+  if (method == MapMethod::normal) back.normals = normals(back.source, back.source_closed)(back.start_rows, Eigen::all);
+  v.starts = basic_ends(method, back, v.ends, settings);
+  v.methods.assign(v.starts.rows(), reversed(basic_method(method)));
+  v.keys.assign(v.starts.rows(), std::numeric_limits<double>::infinity());
+  const std::vector<Index> found = detail::finite_rows(v.starts);
+  if (!found.empty()) {
+    const Points2 located = v.starts(found, Eigen::all);
+    const Vector arcs = CurveIndex(whole_source.points(), whole_source.closed()).closest_points(located).arc_lengths;
+    for (std::size_t j = 0; j < found.size(); ++j) v.keys[found[j]] = whole_source.wrap(arcs[j]);
+  }
+  // A miss keeps its point on the target (ends), so that it can be found; its start is NaN.
+  for (Index i = 0; i < v.starts.rows(); ++i) {
+    if (!v.starts.row(i).allFinite()) v.starts.row(i).setConstant(kNaN);
+  }
+  return v;
+}
+
+bool complete(const Vectors& v) { return v.starts.allFinite() && v.ends.allFinite(); }
+
+// One job with one algorithm. "auto" is the paper's Algorithm 1 on the job: normal mapping, and
+// reverse diffusion instead when normal mapping gives crossings or misses (with a density
+// threshold, the first attempt is reverse minimal distance where the start points are denser
+// than the threshold: the paper's "limiting case of an infinite number of points"). Where reverse
+// diffusion fails on a piece (its mesh cannot be made, streamlines stall), "auto" still answers:
+// forward diffusion, which is crossing-free too; then the first attempt if it missed nothing
+// (crossings and all); then minimal distance, which always finds a point.
+Vectors run(MapMethod method, const Job& job, const std::vector<double>& start_keys,
+            const ArcCurve& whole_source, const Settings& settings) {
+  detail::check_interrupt();
+  if (method != MapMethod::automatic) return forward(method, job, start_keys, settings);
+  if (job.start_rows.empty()) return forward(MapMethod::normal, job, start_keys, settings);
+  const Vectors first = settings.density_threshold > 0.0 &&
+                                point_density(job, start_points(job)) > settings.density_threshold
+                            ? reverse(MapMethod::minimal_distance, job, whole_source, settings)
+                            : forward(MapMethod::normal, job, start_keys, settings);
+  if (complete(first) && count_crossings(first.starts, first.ends) == 0) return first;
+  for (const bool backwards : {true, false}) {
+    try {
+      Vectors v = backwards ? reverse(MapMethod::diffusion, job, whole_source, settings)
+                            : forward(MapMethod::diffusion, job, start_keys, settings);
+      // (A reverse mapping from a target piece without points of its own between the two
+      // meetings has no vectors at all: that leaves the piece of C1 unmapped, not complete.)
+      if (complete(v) && v.starts.rows() > 0) return v;
+    } catch (const GeometryError&) {
+    } catch (const InvalidInput&) {  // a piece the region of which is not what diffusion needs
+    }
+  }
+  if (complete(first)) return first;
+  return forward(MapMethod::minimal_distance, job, start_keys, settings);
+}
+
+// Closed curves without a known pair of anchors: the start of the target (walking in direction)
+// such that equally spaced points of both curves, matched in order, are closest in the sum of
+// squared displacements. A circular cross-correlation by FFT over 2^k samples.
+double best_anchor(const ArcCurve& source, const ArcCurve& target, int direction) {
+  Index m = 64;
+  while (m < 2 * source.size()) m *= 2;
+  std::vector<std::complex<double>> s(m), t(m), fs, ft, product(m), correlation;
+  for (Index j = 0; j < m; ++j) {
+    const Vec2 p = source.point_at(source.length() * j / m);
+    const Vec2 q = target.point_at(direction * target.length() * j / m);
+    s[j] = {p.x(), p.y()};
+    t[j] = {q.x(), q.y()};
+  }
+  Eigen::FFT<double> fft;
+  fft.fwd(fs, s);
+  fft.fwd(ft, t);
+  for (Index j = 0; j < m; ++j) product[j] = std::conj(fs[j]) * ft[j];
+  fft.inv(correlation, product);
+  // sum_i |s_i - t_{i+k}|^2 is smallest where Re sum_i conj(s_i) t_{i+k} is largest.
+  Index best = 0;
+  for (Index k = 1; k < m; ++k) {
+    if (correlation[k].real() > correlation[best].real()) best = k;
+  }
+  return direction * target.length() * best / m;
+}
+
+// +1 when both closed curves turn the same way.
+int relative_direction(const ArcCurve& source, const ArcCurve& target) {
+  return orientation(source.points()) == orientation(target.points()) ? 1 : -1;
+}
+
+// Stacks the vectors of all jobs in the order of their keys (arc position of the start along the
+// source; the reverse-diffusion vectors of "auto" fall in among the others).
+Vectors gather(std::vector<Vectors>& parts) {
+  Index total = 0;
+  for (const Vectors& v : parts) total += v.starts.rows();
+  std::vector<std::pair<std::size_t, Index>> order;
+  order.reserve(total);
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    for (Index i = 0; i < parts[p].starts.rows(); ++i) order.emplace_back(p, i);
+  }
+  std::stable_sort(order.begin(), order.end(), [&](const auto& a, const auto& b) {
+    return parts[a.first].keys[a.second] < parts[b.first].keys[b.second];
+  });
+  Vectors all;
+  all.starts.resize(total, 2);
+  all.ends.resize(total, 2);
+  for (Index r = 0; r < total; ++r) {
+    const Vectors& v = parts[order[r].first];
+    all.starts.row(r) = v.starts.row(order[r].second);
+    all.ends.row(r) = v.ends.row(order[r].second);
+    all.methods.push_back(v.methods[order[r].second]);
+  }
+  return all;
+}
+
+Vectors map_directed(const Points2& source_points, const Points2& target_points, MapMethod method,
+                     bool closed, bool split, const std::optional<std::pair<Vec2, Vec2>>& anchors,
+                     const Settings& settings) {
+  const ArcCurve source(source_points, closed, "c1");
+  const ArcCurve target(target_points, closed, "c2");
+  const Index n = source.size();
+  const bool wants_normals = method == MapMethod::normal || method == MapMethod::automatic;
+  const Points2 source_normals = wants_normals ? normals(source.points(), closed) : Points2();
+  const int direction = closed ? relative_direction(source, target) : 1;
+
+  CurveIntersections crossings;
+  if (split || (closed && method == MapMethod::uniform)) {
+    crossings = curve_intersections(source.points(), target.points(), closed);
+  }
+  const Index k = crossings.points.rows();
+  // Where the curves meet: the crossings (when splitting) and, always, the stretches where they
+  // touch or run together, which no region between them spans.
+  const double tolerance = settings.contact_tolerance >= 0.0 ? settings.contact_tolerance
+                                                             : detail::default_contact_tolerance(source, target);
+  const std::vector<Meeting> found =
+      detail::find_meetings(source, target, split ? crossings : CurveIntersections(), tolerance);
+  bool in_order = true;
+  std::vector<Meeting> meetings = detail::meetings_in_order(found, target, direction, &in_order);
+  const bool contact = std::any_of(found.begin(), found.end(), [](const Meeting& m) { return !m.crossing; });
+  // Crossings alone that do not pair up in order: map the whole curves (diffusion handles
+  // crossing curves as one region).
+  if (!in_order && !contact) meetings.clear();
+  // A closed pair that meets at one point only has no two pieces to pair: the piece between the
+  // point and itself would be the whole curve onto a point of the target. Map the whole curves.
+  if (closed && meetings.size() == 1 && meetings[0].source_begin == meetings[0].source_end) meetings.clear();
+
+  auto add_starts = [&](Job& job, const std::vector<Index>& points, Index first_row) {
+    for (std::size_t j = 0; j < points.size(); ++j) job.start_rows.push_back(first_row + j);
+    if (wants_normals) {
+      job.normals.resize(points.size(), 2);
+      for (std::size_t j = 0; j < points.size(); ++j) job.normals.row(j) = source_normals.row(points[j]);
+    }
+  };
+
+  if (meetings.empty()) {
+    Job job;
+    job.source = source.points();
+    job.source_closed = closed;
+    std::vector<Index> all(n);
+    std::vector<double> keys(n);
+    for (Index i = 0; i < n; ++i) all[i] = i, keys[i] = source.arc(i);
+    add_starts(job, all, 0);
+    job.target = target.points();
+    job.target_closed = closed;
+    if (method == MapMethod::uniform) {
+      double from = 0.0;  // source anchor
+      if (!closed) {
+        job.anchor = 0.0;
+      } else if (k > 0) {
+        from = crossings.arc_lengths1[0];
+        job.anchor = crossings.arc_lengths2[0];
+      } else if (anchors) {
+        from = closest_points(anchors->first.transpose(), source.points(), true).arc_lengths[0];
+        job.anchor = closest_points(anchors->second.transpose(), target.points(), true).arc_lengths[0];
+      } else {
+        job.anchor = best_anchor(source, target, direction);
+      }
+      job.direction = direction;
+      job.fractions.resize(n);
+      for (Index i = 0; i < n; ++i) job.fractions[i] = source.forward(from, source.arc(i)) / source.length();
+    }
+    std::vector<Vectors> parts{run(method, job, keys, source, settings)};
+    return gather(parts);
+  }
+
+  // Split: each piece runs from the end of one meeting to the start of the next (open curves also
+  // from their start to the first and from the last to their end) and maps onto the target
+  // between the same two meetings. A crossing maps onto itself and is a start point of its own;
+  // the source points on a contact stretch map to their closest point on the target.
+  const Index count = static_cast<Index>(meetings.size());
+  struct End {
+    double s, t;  // arc positions on source and target
+    Vec2 p, q;    // the points there
+    bool meeting;
+  };
+  std::vector<std::pair<End, End>> pieces;
+  auto begin_of = [&](const Meeting& m, double shift) {
+    return End{m.source_begin + shift, m.target_begin, m.source_point_begin, m.target_point_begin, true};
+  };
+  auto end_of = [&](const Meeting& m) {
+    return End{m.source_end, m.target_end, m.source_point_end, m.target_point_end, true};
+  };
+  if (closed) {
+    for (Index p = 0; p < count; ++p) {
+      pieces.emplace_back(end_of(meetings[p]), begin_of(meetings[(p + 1) % count], p + 1 == count ? source.length() : 0.0));
+    }
+  } else {
+    const Index last = n - 1;
+    pieces.emplace_back(End{0.0, 0.0, source.points().row(0).transpose(), target.points().row(0).transpose(), false},
+                        begin_of(meetings[0], 0.0));
+    for (Index p = 0; p + 1 < count; ++p) pieces.emplace_back(end_of(meetings[p]), begin_of(meetings[p + 1], 0.0));
+    pieces.emplace_back(end_of(meetings[count - 1]),
+                        End{source.length(), target.length(), source.points().row(last).transpose(),
+                            target.points().row(target.size() - 1).transpose(), false});
+  }
+
+  std::vector<Vectors> parts(1);
+  Vectors& fixed = parts[0];
+  std::vector<char> on_stretch(n, 0);
+  std::vector<Vec2> fixed_starts, fixed_ends;
+  std::vector<Method> fixed_methods;
+  const Method crossing_method = basic_method(method == MapMethod::automatic ? MapMethod::normal : method);
+  for (const Meeting& m : meetings) {
+    if (m.crossing) {
+      fixed_starts.push_back(m.source_point_begin), fixed_ends.push_back(m.source_point_begin);
+      fixed.keys.push_back(m.source_begin), fixed_methods.push_back(crossing_method);
+      continue;
+    }
+    for (Index v = m.first_vertex;; v = (v + 1) % n) {
+      on_stretch[v] = 1;
+      if (v == m.last_vertex) break;
+    }
+  }
+  std::vector<Index> stretch_rows;
+  for (Index i = 0; i < n; ++i) {
+    if (on_stretch[i]) stretch_rows.push_back(i);
+  }
+  if (!stretch_rows.empty()) {
+    const Points2 queries = source.points()(stretch_rows, Eigen::all);
+    const Points2 closest = CurveIndex(target.points(), closed).closest_points(queries).points;
+    for (std::size_t j = 0; j < stretch_rows.size(); ++j) {
+      fixed_starts.push_back(queries.row(j).transpose()), fixed_ends.push_back(closest.row(j).transpose());
+      fixed.keys.push_back(source.arc(stretch_rows[j])), fixed_methods.push_back(Method::minimal_distance);
+    }
+  }
+  fixed.starts.resize(fixed_starts.size(), 2);
+  fixed.ends.resize(fixed_ends.size(), 2);
+  for (std::size_t j = 0; j < fixed_starts.size(); ++j) {
+    fixed.starts.row(j) = fixed_starts[j].transpose(), fixed.ends.row(j) = fixed_ends[j].transpose();
+  }
+  fixed.methods = std::move(fixed_methods);
+
+  // Each other source point goes to the piece it lies in; a point that is (within rounding) a
+  // crossing stays where it is, as the crossings do.
+  const double coincident = 1e-12 * source.length();
+  std::vector<double> begins(count);
+  for (Index p = 0; p < count; ++p) begins[p] = meetings[p].source_begin;
+  std::vector<std::vector<Index>> members(pieces.size());
+  for (Index i = 0; i < n; ++i) {
+    if (on_stretch[i]) continue;
+    const double s = source.arc(i);
+    const Index after = std::upper_bound(begins.begin(), begins.end(), s) - begins.begin();
+    bool on_crossing = false;
+    for (Index c : {after - 1, after}) {
+      if (c >= 0 && c < count && meetings[c].crossing && source.between(s, meetings[c].source_begin) <= coincident) {
+        on_crossing = true;
+      }
+    }
+    if (on_crossing) continue;
+    members[closed ? (after == 0 ? count - 1 : after - 1) : after].push_back(i);
+  }
+
+  for (std::size_t p = 0; p < pieces.size(); ++p) {
+    std::vector<Index>& m = members[p];
+    if (m.empty()) continue;
+    const End &from = pieces[p].first, &to = pieces[p].second;
+    // Along the piece: the closing piece of a closed curve wraps past the first point.
+    std::stable_sort(m.begin(), m.end(), [&](Index a, Index b) {
+      return source.forward(from.s, source.arc(a)) < source.forward(from.s, source.arc(b));
+    });
+    Job job;
+    const Index offset = from.meeting ? 1 : 0;
+    job.source.resize(offset + m.size() + (to.meeting ? 1 : 0), 2);
+    if (from.meeting) job.source.row(0) = from.p.transpose();
+    for (std::size_t j = 0; j < m.size(); ++j) job.source.row(offset + j) = source.points().row(m[j]);
+    if (to.meeting) job.source.row(job.source.rows() - 1) = to.p.transpose();
+    add_starts(job, m, offset);
+    job.shared_begin = from.meeting, job.shared_end = to.meeting;
+    job.target = closed && direction < 0 ? Points2(target.piece(to.t, from.t).colwise().reverse()) : target.piece(from.t, to.t);
+    // The pieces end exactly at the meetings (the target's are found by arc length).
+    if (from.meeting) job.target.row(0) = from.q.transpose();
+    if (to.meeting) job.target.row(job.target.rows() - 1) = to.q.transpose();
+    if (method == MapMethod::uniform) {
+      const double length = to.s - from.s;
+      job.fractions.resize(m.size());
+      for (std::size_t j = 0; j < m.size(); ++j) {
+        const double along = closed ? source.forward(from.s, source.arc(m[j])) : source.arc(m[j]) - from.s;
+        job.fractions[j] = length > 0 ? along / length : 0.0;
+      }
+    }
+    std::vector<double> keys(m.size());
+    for (std::size_t j = 0; j < m.size(); ++j) keys[j] = source.arc(m[j]);
+    parts.push_back(run(method, job, keys, source, settings));
+  }
+  return gather(parts);
+}
+
+// Puts the finite rows of points onto the curve (their closest points).
+void project_onto(Points2& points, const Points2Ref& curve, bool closed) {
+  const std::vector<Index> rows = detail::finite_rows(points);
+  if (rows.empty()) return;
+  const Points2 queries = points(rows, Eigen::all);
+  const Points2 on_curve = CurveIndex(curve, closed).closest_points(queries).points;
+  for (std::size_t j = 0; j < rows.size(); ++j) points.row(rows[j]) = on_curve.row(j);
+}
+
+}  // namespace
+
+DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2,
+                              const CurveMappingOptions& options) {
+  const bool closed = options.closed;
+  const Index n1 = detail::require_simple_curve(c1, closed, "c1");
+  const Index n2 = detail::require_simple_curve(c2, closed, "c2");
+  if (options.n < 0 || (options.n > 0 && options.n < (closed ? 3 : 2))) {
+    detail::invalid("n", "must be 0 (use the given points) or at least " +
+                              std::string(closed ? "3" : "2") + ", got " + std::to_string(options.n));
+  }
+  if (!(options.density_threshold >= 0.0) || !std::isfinite(options.density_threshold)) {
+    detail::invalid("density_threshold", "must be a finite number >= 0 (0: off)");
+  }
+  if (std::isnan(options.contact_tolerance) || std::isinf(options.contact_tolerance)) {
+    detail::invalid("contact_tolerance", "must be a finite length >= 0, or negative for the default");
+  }
+  detail::require_diffusion_options(options.diffusion);
+  // Frames of one organ overlap; closed curves that neither cross nor nest are the wrong pair
+  // (other units, another offset), whatever a method would make of them.
+  // (Each curve's point farthest from the other decides: a touching point would not.)
+  auto farthest = [](const Points2Ref& points, const Points2Ref& curve) -> Vec2 {
+    Index at = 0;
+    CurveIndex(curve, true).closest_points(points).distances.maxCoeff(&at);
+    return points.row(at).transpose();
+  };
+  if (closed && curve_intersections(c1.topRows(n1), c2.topRows(n2), true).points.rows() == 0 &&
+      !detail::inside(farthest(c1.topRows(n1), c2.topRows(n2)), c2.topRows(n2)) &&
+      !detail::inside(farthest(c2.topRows(n2), c1.topRows(n1)), c1.topRows(n1))) {
+    detail::invalid("c2", "lies apart from c1 (the curves neither cross nor enclose one another): consecutive "
+                          "frames of one organ overlap; check their units and offsets");
+  }
+  Points2 a = options.n > 0 ? resample(c1, options.n, closed) : Points2(c1.topRows(n1));
+  const Points2 b = options.n > 0 ? resample(c2, options.n, closed) : Points2(c2.topRows(n2));
+
+  Similarity2 similarity;
+  if (options.transform) {
+    similarity = align_curves(a, b, closed);
+    a = similarity.apply(a);
+  }
+  std::optional<std::pair<Vec2, Vec2>> anchors;
+  if (options.anchor) {
+    if (!options.anchor->allFinite()) detail::invalid("anchor", "has a non-finite coordinate");
+    Points2 anchor = options.anchor->transpose();
+    if (options.transform) anchor = similarity.apply(anchor);
+    const Vec2 on_c1 = closest_points(anchor, a, closed).points.row(0).transpose();
+    const Vec2 on_c2 = closest_points(on_c1.transpose(), b, closed).points.row(0).transpose();
+    anchors = options.reverse ? std::make_pair(on_c2, on_c1) : std::make_pair(on_c1, on_c2);
+  }
+
+  Settings settings;
+  settings.density_threshold = options.density_threshold;
+  settings.contact_tolerance = options.contact_tolerance;
+  settings.diffusion = options.diffusion;
+  settings.stretch_weight = options.stretch_weight;
+  Vectors v = options.reverse ? map_directed(b, a, options.method, closed, options.split, anchors, settings)
+                              : map_directed(a, b, options.method, closed, options.split, anchors, settings);
+  DisplacementField2 field;
+  field.starts = std::move(options.reverse ? v.ends : v.starts);
+  field.ends = std::move(options.reverse ? v.starts : v.ends);
+  field.methods = std::move(v.methods);
+  if (options.reverse) {
+    for (Method& m : field.methods) m = reversed(m);
+  }
+  if (options.transform) field.starts = similarity.apply_inverse(field.starts);
+  // Resampled curves cut the corners of the given ones: the points found on them go onto the
+  // curves the caller passed, so that quality(field, c1, c2) measures the field on those.
+  if (options.n > 0) {
+    project_onto(field.starts, c1.topRows(n1), closed);
+    project_onto(field.ends, c2.topRows(n2), closed);
+  }
+  return field;
+}
+
+}  // namespace morphomap

@@ -1,0 +1,308 @@
+// The monotone matching behind method "optimal": dynamic programming over start points x target
+// samples, coarse to fine with a band around the coarser path.
+#include <morphomap/curve_queries.hpp>
+#include <morphomap/optimal.hpp>
+
+#include "common/interrupt_check.hpp"
+#include "common/numbers.hpp"
+#include "common/validation.hpp"
+#include "curves/arc_curve.hpp"
+
+#include <morphomap/errors.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace morphomap {
+
+using detail::kInf;
+
+namespace {
+
+using detail::ArcCurve;
+constexpr double kCrossing = 1e6;  // added where two consecutive vectors cross
+constexpr Index kThinning = 4;     // starts per level
+constexpr Index kCoarsest = 256;   // the full grid is searched at or below this many starts
+constexpr Index kRecent = 3;       // vectors back along the path checked for crossings
+
+// The problem of one call: start points with their arc positions, the two pieces' lengths, the
+// virtual vectors at both ends, and the weights.
+struct Problem {
+  Points2 starts;
+  Vector s;  // arc position of each start along the source
+  double source_length = 0.0, target_length = 0.0;
+  Vec2 begin_source, begin_target, end_source, end_target;
+  bool pinned_first = false, pinned_last = false;
+  double displacement_weight = 1.0;  // 1 / g^2
+  double stretch_weight = kDefaultStretchWeight;
+  double alpha = 1.0;
+  const ArcCurve* target = nullptr;
+};
+
+double orient(const Vec2& a, const Vec2& b, const Vec2& c) {
+  return (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
+}
+
+// p, on the line through a and b, lies within the segment a-b.
+bool within(const Vec2& a, const Vec2& b, const Vec2& p) {
+  return std::min(a.x(), b.x()) <= p.x() && p.x() <= std::max(a.x(), b.x()) && std::min(a.y(), b.y()) <= p.y() &&
+         p.y() <= std::max(a.y(), b.y());
+}
+
+// The segments a0-a1 and b0-b1 meet other than at a shared end point: the definition of
+// count_crossings (a start point lying on the neighbouring vector counts, as on pixel-grid frames
+// where both run along one row).
+bool cross(const Vec2& a0, const Vec2& a1, const Vec2& b0, const Vec2& b1) {
+  const double d1 = orient(b0, b1, a0), d2 = orient(b0, b1, a1);
+  const double d3 = orient(a0, a1, b0), d4 = orient(a0, a1, b1);
+  if (((d1 < 0 && d2 > 0) || (d1 > 0 && d2 < 0)) && ((d3 < 0 && d4 > 0) || (d3 > 0 && d4 < 0))) return true;
+  auto touches = [](double d, const Vec2& p, const Vec2& s0, const Vec2& s1) {
+    return d == 0.0 && p != s0 && p != s1 && within(s0, s1, p);
+  };
+  return touches(d1, a0, b0, b1) || touches(d2, a1, b0, b1) || touches(d3, b0, a0, a1) || touches(d4, b1, a0, a1);
+}
+
+// One level: the starts `rows` (indices into Problem::starts, increasing), the target sampled at
+// M + 1 positions, and for each row the range of samples it may take.
+struct Level {
+  std::vector<Index> rows;
+  Index samples = 0;  // M
+  std::vector<Index> lo, hi;
+};
+
+// Feasible sample range of row r of R so that a strictly increasing path exists.
+std::pair<Index, Index> feasible(const Problem& p, Index r, Index count, Index samples) {
+  if (r == 0 && p.pinned_first) return {0, 0};
+  if (r == count - 1 && p.pinned_last) return {samples, samples};
+  const Index lo = p.pinned_first ? r : r + 1;
+  const Index hi = p.pinned_last ? samples - (count - 1 - r) : samples - (count - r);
+  return {lo, hi};
+}
+
+Index max_step(Index samples, Index count) { return 8 * samples / (count + 1) + 2; }
+
+// The DP on one level: fills path (a sample per row) and energy; false if the ranges admit no
+// path.
+bool solve_level(const Problem& p, const Level& level, std::vector<Index>& path, double& energy) {
+  const Index count = static_cast<Index>(level.rows.size());
+  const Index samples = level.samples;
+  const double step_length = p.target_length / static_cast<double>(samples);
+  const Index reach = max_step(samples, count);
+  std::vector<Vec2> q(samples + 1);
+  for (Index k = 0; k <= samples; ++k) q[k] = p.target->point_at(step_length * k);
+  q[0] = p.begin_target, q[samples] = p.end_target;
+
+  auto stretch = [&](double target_gap, double source_gap) {
+    if (!(source_gap > 0.0)) return 0.0;
+    const double r = target_gap / (p.alpha * source_gap) - 1.0;
+    return p.stretch_weight * r * r;
+  };
+
+  std::vector<std::vector<double>> cost(count);
+  std::vector<std::vector<std::int32_t>> back(count);
+  // Whether the vector p -> end crosses one of the kRecent vectors before it on the best path
+  // into (r - 1, kp): its neighbour exactly, the ones further back as that path has them (the
+  // DP's state holds one vector; staircase contours cross two or three apart).
+  auto crosses_recent = [&](const Level& lv, const std::vector<std::vector<std::int32_t>>& from_row, Index r,
+                            Index kp, const Vec2& point, const Vec2& end) {
+    Index k_back = kp;
+    for (Index d = 1; d <= kRecent && r - d >= 0; ++d) {
+      if (d > 1) {
+        k_back = from_row[r - d + 1][k_back - lv.lo[r - d + 1]];
+        if (k_back < 0) break;
+      }
+      if (cross(p.starts.row(lv.rows[r - d]).transpose(), q[k_back], point, end)) return true;
+    }
+    return false;
+  };
+  for (Index r = 0; r < count; ++r) {
+    if ((r & 63) == 0) detail::check_interrupt();
+    const Index lo = level.lo[r], hi = level.hi[r];
+    if (lo > hi) return false;
+    const Index i = level.rows[r];
+    const Vec2 pi = p.starts.row(i).transpose();
+    cost[r].assign(hi - lo + 1, kInf);
+    back[r].assign(hi - lo + 1, -1);
+    // The previous vector: the virtual one at the start of the pieces, or row r - 1.
+    const bool first = r == 0;
+    const double prev_s = first ? 0.0 : p.s[level.rows[r - 1]];
+    const Index plo = first ? 0 : level.lo[r - 1], phi = first ? 0 : level.hi[r - 1];
+    const double dl = p.s[i] - prev_s;
+    // A long source edge (curves are not resampled by default) may take as long a target arc.
+    const Index row_reach =
+        p.source_length > 0.0
+            ? std::max(reach, static_cast<Index>(std::ceil(8.0 * static_cast<double>(samples) * dl / p.source_length)) + 2)
+            : reach;
+    for (Index k = lo; k <= hi; ++k) {
+      const double displacement = p.displacement_weight * (pi - q[k]).squaredNorm();
+      double best = kInf;
+      Index arg = -1;
+      const bool pinned = first && p.pinned_first;
+      const Index from = std::max(plo, pinned ? k : k - row_reach), to = std::min(phi, pinned ? k : k - 1);
+      for (Index kp = from; kp <= to; ++kp) {
+        const double before = first ? 0.0 : cost[r - 1][kp - plo];
+        if (before == kInf) continue;
+        double c = before + stretch(step_length * (k - kp), dl);
+        if (!(c < best)) continue;  // the crossing tests only where the step could win
+        if (!first && crosses_recent(level, back, r, kp, pi, q[k])) c += kCrossing;
+        if (c < best) best = c, arg = kp;
+      }
+      if (arg >= 0) cost[r][k - lo] = best + displacement, back[r][k - lo] = static_cast<std::int32_t>(arg);
+    }
+  }
+  // Close onto the virtual vector at the end of the pieces.
+  const Index last = level.rows[count - 1];
+  const double dl = p.source_length - p.s[last];
+  double best = kInf;
+  Index arg = -1;
+  for (Index k = level.lo[count - 1]; k <= level.hi[count - 1]; ++k) {
+    double c = cost[count - 1][k - level.lo[count - 1]];
+    if (c == kInf) continue;
+    if (!(p.pinned_last)) {
+      c += stretch(p.target_length - step_length * k, dl);
+      if (cross(p.starts.row(last).transpose(), q[k], p.end_source, p.end_target)) c += kCrossing;
+    }
+    if (c < best) best = c, arg = k;
+  }
+  if (arg < 0) return false;
+  energy = best;
+  path.assign(count, 0);
+  for (Index r = count - 1; r >= 0; --r) {
+    path[r] = arg;
+    arg = back[r][arg - level.lo[r]];
+  }
+  return true;
+}
+
+// The coarser path carried to a finer level: the target position of each fine row, linear in
+// the source position between the coarse rows (and the virtual ends).
+std::vector<double> carry(const Problem& p, const std::vector<Index>& coarse_rows, const std::vector<double>& coarse_t,
+                          const std::vector<Index>& fine_rows) {
+  std::vector<double> s{0.0}, t{0.0};
+  for (std::size_t c = 0; c < coarse_rows.size(); ++c) s.push_back(p.s[coarse_rows[c]]), t.push_back(coarse_t[c]);
+  s.push_back(p.source_length), t.push_back(p.target_length);
+  std::vector<double> out(fine_rows.size());
+  std::size_t j = 0;
+  for (std::size_t r = 0; r < fine_rows.size(); ++r) {
+    const double x = p.s[fine_rows[r]];
+    while (j + 2 < s.size() && s[j + 1] <= x) ++j;
+    const double span = s[j + 1] - s[j];
+    const double f = span > 0.0 ? std::clamp((x - s[j]) / span, 0.0, 1.0) : 0.0;
+    out[r] = t[j] + f * (t[j + 1] - t[j]);
+  }
+  return out;
+}
+
+}  // namespace
+
+MonotoneMatch monotone_match(const Points2Ref& source, const std::vector<Index>& start_rows,
+                             const Points2Ref& target, double stretch_weight) {
+  if (!(stretch_weight >= 0.0) || !std::isfinite(stretch_weight)) {
+    detail::invalid("stretch_weight", "must be a finite number >= 0, got " + std::to_string(stretch_weight));
+  }
+  if (source.rows() < 2) detail::invalid("source", "needs at least 2 points");
+  if (target.rows() < 2) detail::invalid("target", "needs at least 2 points");
+  if (!source.allFinite()) detail::invalid("source", "has a non-finite coordinate");
+  if (!target.allFinite()) detail::invalid("target", "has a non-finite coordinate");
+  const Index n = static_cast<Index>(start_rows.size());
+  for (Index r = 0; r < n; ++r) {
+    if (start_rows[r] < 0 || start_rows[r] >= source.rows() || (r > 0 && start_rows[r] <= start_rows[r - 1])) {
+      detail::invalid("start_rows", "must be increasing rows of source");
+    }
+  }
+  MonotoneMatch match;
+  match.arcs.resize(n);
+  match.points.resize(n, 2);
+  if (n == 0) return match;
+
+  // Arc positions along both open polylines (repeated points kept: the pieces may touch).
+  Vector source_arc(source.rows());
+  source_arc[0] = 0.0;
+  for (Index i = 1; i < source.rows(); ++i) source_arc[i] = source_arc[i - 1] + (source.row(i) - source.row(i - 1)).norm();
+  double target_length = 0.0;
+  for (Index i = 1; i < target.rows(); ++i) target_length += (target.row(i) - target.row(i - 1)).norm();
+  if (!(target_length > 0.0)) {  // a target piece shrunk to a point takes every start
+    match.arcs.setZero();
+    match.points = target.row(0).replicate(n, 1);
+    return match;
+  }
+  const ArcCurve curve(target, false, "target");
+
+  Problem p;
+  p.starts = source(start_rows, Eigen::all);
+  p.s = source_arc(start_rows);
+  p.source_length = source_arc[source.rows() - 1];
+  p.target_length = curve.length();
+  p.begin_source = source.row(0).transpose(), p.end_source = source.row(source.rows() - 1).transpose();
+  p.begin_target = target.row(0).transpose(), p.end_target = target.row(target.rows() - 1).transpose();
+  p.pinned_first = start_rows.front() == 0;
+  p.pinned_last = start_rows.back() == source.rows() - 1 && !(n == 1 && p.pinned_first);
+  p.stretch_weight = stretch_weight;
+  p.alpha = p.source_length > 0.0 ? p.target_length / p.source_length : 1.0;
+  p.target = &curve;
+  const double gap2 = CurveIndex(target, false).closest_points(p.starts).distances.array().square().mean();
+  const double spacing = p.source_length / static_cast<double>(n + 1);
+  const double scale = std::max({gap2, spacing * spacing, 1e-300});
+  p.displacement_weight = 1.0 / scale;
+
+  const Index finest = std::max(4 * (n + 1), std::min<Index>(target.rows(), 8 * (n + 1)));
+  match.samples = finest;
+
+  // The levels, finest first: every kThinning-th start of the level below (the pinned ends kept).
+  std::vector<std::vector<Index>> levels{std::vector<Index>(n)};
+  for (Index r = 0; r < n; ++r) levels[0][r] = r;
+  while (static_cast<Index>(levels.back().size()) > kCoarsest) {
+    const std::vector<Index>& below = levels.back();
+    std::vector<Index> rows;
+    for (std::size_t r = 0; r < below.size(); r += kThinning) rows.push_back(below[r]);
+    if (p.pinned_last && rows.back() != n - 1) rows.push_back(n - 1);
+    levels.push_back(std::move(rows));
+  }
+
+  std::vector<Index> coarse_rows;
+  std::vector<double> coarse_t;
+  double energy = 0.0;
+  for (auto level_rows = levels.rbegin(); level_rows != levels.rend(); ++level_rows) {
+    Level level;
+    level.rows = *level_rows;
+    const Index count = static_cast<Index>(level.rows.size());
+    level.samples = std::max(4 * (count + 1), (finest * (count + 1) + n) / (n + 1));
+    const double per_sample = p.target_length / static_cast<double>(level.samples);
+    const std::vector<double> centre = coarse_rows.empty() ? std::vector<double>() : carry(p, coarse_rows, coarse_t, level.rows);
+    Index band = std::max<Index>(16, 8 * level.samples / (count + 1));
+    std::vector<Index> path;
+    for (;;) {
+      level.lo.resize(count), level.hi.resize(count);
+      for (Index r = 0; r < count; ++r) {
+        auto [lo, hi] = feasible(p, r, count, level.samples);
+        if (!centre.empty() && band < level.samples) {
+          const Index c = static_cast<Index>(std::llround(centre[r] / per_sample));
+          lo = std::max(lo, c - band), hi = std::min(hi, c + band);
+        }
+        level.lo[r] = lo, level.hi[r] = hi;
+      }
+      if (solve_level(p, level, path, energy)) break;
+      if (centre.empty() || band >= level.samples) {
+        throw GeometryError("optimal: no monotone matching (more start points than the target can separate)");
+      }
+      band *= 2;
+    }
+    coarse_rows = level.rows;
+    coarse_t.resize(count);
+    for (Index r = 0; r < count; ++r) coarse_t[r] = per_sample * path[r];
+  }
+  for (Index r = 0; r < n; ++r) {
+    match.arcs[r] = coarse_t[r];
+    match.points.row(r) = curve.point_at(coarse_t[r]).transpose();
+  }
+  if (p.pinned_first) match.points.row(0) = p.begin_target.transpose();
+  if (p.pinned_last) match.points.row(n - 1) = p.end_target.transpose();
+  match.energy = energy;
+  return match;
+}
+
+}  // namespace morphomap

@@ -1,0 +1,162 @@
+// The paper's 3D mapping: minimal distance, normal and diffusion mapping of the vertices of one
+// closed surface onto another, with reverse and "auto" (normal, else reverse diffusion).
+#include <morphomap/laplace3d.hpp>
+#include <morphomap/quality.hpp>
+#include <morphomap/surface_mapping.hpp>
+#include <morphomap/surface_queries.hpp>
+
+#include "common/finite_rows.hpp"
+#include "common/numbers.hpp"
+#include "common/validation.hpp"
+#include "diffusion/shell_mesh.hpp"
+#include "quality/folds.hpp"
+
+#include <morphomap/errors.hpp>
+
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <utility>
+#include <vector>
+
+namespace morphomap {
+
+using detail::kNaN;
+
+namespace {
+
+
+struct Surface {
+  Points3Ref vertices;
+  FacesRef faces;
+};
+
+// Vectors from the vertices of `source` to `target` (queried through `target_index`, built from
+// it) with one basic algorithm. Diffusion's fold repair also queries `source`: through
+// `source_index` where the caller has one, else through one built here.
+DisplacementField3 basic(MapMethod method, const Surface& source, const Surface& target,
+                         const SurfaceIndex& target_index, double mesh_size,
+                         const SurfaceIndex* source_index = nullptr) {
+  DisplacementField3 field;
+  field.starts = source.vertices;
+  field.faces = source.faces;
+  switch (method) {
+    case MapMethod::minimal_distance:
+      field.ends = target_index.closest_points(field.starts).points;
+      field.methods.assign(field.size(), Method::minimal_distance);
+      break;
+    case MapMethod::normal: {
+      const Points3 normals = vertex_normals(source.vertices, source.faces);
+      field.ends = target_index.line_intersections(field.starts, normals).points;
+      field.methods.assign(field.size(), Method::normal);
+      break;
+    }
+    case MapMethod::diffusion: {
+      ShellDiffusionOptions options;
+      options.mesh_size = mesh_size;
+      const ShellDiffusionSolution solution =
+          solve_diffusion_3d(source.vertices, source.faces, target.vertices, target.faces, options);
+      if (solution.ends.rows() != field.size()) throw GeometryError("diffusion: the solver returned the wrong number of ends");
+      // The tetrahedral mesh only approximates the target: put each end onto the target itself.
+      field.ends = solution.ends;
+      const std::vector<Index> rows = detail::finite_rows(field.ends);
+      const Points3 found = field.ends(rows, Eigen::all);
+      const Points3 on_target = target_index.closest_points(found).points;
+      for (std::size_t k = 0; k < rows.size(); ++k) field.ends.row(rows[k]) = on_target.row(k);
+      // The streamlines do not cross; the few slivers their discrete form flips are repaired.
+      std::unique_ptr<SurfaceIndex> own_index;
+      if (source_index == nullptr) {
+        own_index = std::make_unique<SurfaceIndex>(source.vertices, source.faces);
+        source_index = own_index.get();
+      }
+      const Points3 placed = field.ends;
+      detail::unfold(field.starts, field.ends, field.faces, source.vertices, source.faces, *source_index,
+                     target.vertices, target.faces, target_index);
+      // Touching vertices went to their closest point, unless the repair has moved them since.
+      field.methods.assign(field.size(), Method::diffusion);
+      for (Index i = 0; i < field.size(); ++i) {
+        if (solution.touching[static_cast<std::size_t>(i)] && field.ends.row(i) == placed.row(i)) {
+          field.methods[i] = Method::minimal_distance;
+        }
+      }
+      break;
+    }
+    default:
+      detail::invalid("method", "uniform mapping has no 3D form; use 'minimal_distance', 'normal', 'diffusion' or 'auto'");
+  }
+  return field;
+}
+
+// A field from one surface to another turned round (starts and ends swapped, rows and faces kept,
+// methods named the other way round); a row that found nothing keeps its known point, the other
+// end NaN.
+DisplacementField3 flipped(DisplacementField3 field) {
+  std::swap(field.starts, field.ends);
+  for (Method& m : field.methods) m = reversed(m);
+  return field;
+}
+
+bool complete(const DisplacementField3& field) {
+  for (Index i = 0; i < field.size(); ++i) {
+    if (!field.valid(i)) return false;
+  }
+  return true;
+}
+
+// "auto": normal mapping where it misses nothing and folds no triangle; else reverse diffusion
+// (the paper's choice), else diffusion (both fold-free by construction), else the normal mapping
+// if it missed nothing, else minimal distance (which always finds a point): it answers wherever a
+// basic algorithm does.
+DisplacementField3 automatic(const Surface& source, const Surface& target, const SurfaceIndex& target_index,
+                             double mesh_size) {
+  DisplacementField3 normal = basic(MapMethod::normal, source, target, target_index, mesh_size);
+  const SurfaceIndex source_index(source.vertices, source.faces);
+  const bool missed = !complete(normal);
+  if (!missed && count_folds(normal.starts, normal.ends, normal.faces, source.vertices, source.faces, source_index,
+                             target.vertices, target.faces, target_index) == 0) {
+    return normal;
+  }
+  for (const bool backwards : {true, false}) {
+    try {
+      DisplacementField3 field =
+          backwards ? flipped(basic(MapMethod::diffusion, target, source, source_index, mesh_size, &target_index))
+                    : basic(MapMethod::diffusion, source, target, target_index, mesh_size, &source_index);
+      if (complete(field)) return field;
+    } catch (const GeometryError&) {
+    } catch (const InvalidInput&) {  // surfaces whose region diffusion cannot mesh (they coincide in part, say)
+    }
+  }
+  if (!missed) return normal;
+  return basic(MapMethod::minimal_distance, source, target, target_index, mesh_size);
+}
+
+DisplacementField3 directed(MapMethod method, const Surface& source, const Surface& target, double mesh_size) {
+  const SurfaceIndex target_index(target.vertices, target.faces);
+  if (method == MapMethod::automatic) return automatic(source, target, target_index, mesh_size);
+  return basic(method, source, target, target_index, mesh_size);
+}
+
+}  // namespace
+
+DisplacementField3 map_surfaces(const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2,
+                                const SurfaceMappingOptions& options) {
+  detail::require_outward(check_closed_surface(v1, f1, "s1"), "s1");
+  detail::require_outward(check_closed_surface(v2, f2, "s2"), "s2");
+  // Both surfaces free of self-intersections (classify_nesting checks), and overlapping: frames
+  // of one organ do (see map_curves).
+  if (detail::classify_nesting(v1, f1, v2, f2) == detail::Nesting::disjoint) {
+    detail::invalid("s2", "lies apart from s1 (the surfaces neither cross nor enclose one another): consecutive "
+                          "frames of one organ overlap; check their units and offsets");
+  }
+  if (options.method == MapMethod::uniform) {
+    detail::invalid("method", "uniform mapping has no 3D form; use 'minimal_distance', 'normal', 'diffusion' or 'auto'");
+  }
+  if (!(options.diffusion_mesh_size >= 0) || !std::isfinite(options.diffusion_mesh_size)) {
+    detail::invalid("mesh_size", "must be a finite number >= 0");
+  }
+  const Surface s1{v1, f1}, s2{v2, f2};
+  if (!options.reverse) return directed(options.method, s1, s2, options.diffusion_mesh_size);
+  return flipped(directed(options.method, s2, s1, options.diffusion_mesh_size));
+}
+
+}  // namespace morphomap

@@ -1,0 +1,5 @@
+"""The ``morphomap`` command: ``demo``, ``map``, ``extend``, ``series`` and ``batch``."""
+
+from .main import main
+
+__all__ = ["main"]

@@ -1,0 +1,7 @@
+"""Segmented images in: reading masks and stacks with their spacing, and the boundary of a mask as
+a curve (2D) or a remeshed surface (3D)."""
+
+from .masks import boundary_from_mask, surface_from_mask
+from .read import Image, read_image
+
+__all__ = ["Image", "boundary_from_mask", "read_image", "surface_from_mask"]

@@ -1,0 +1,40 @@
+"""One frame of a time series from a file: a curve, a surface, or the boundary in a mask."""
+
+from __future__ import annotations
+
+import os
+
+IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".npy")
+
+
+def read_boundary(path, *, spacing=None, label=None, smooth=0.0, edge_length=None, report=None):
+    """``(boundary, from_image)``: the curve in a CSV file, the surface in a mesh file (STL, PLY,
+    OBJ, OFF), or the boundary of the mask in an image file (a 2D mask gives a curve, a 3D stack a
+    surface), at ``spacing`` (one value or one per axis), else the spacing the file states, else 1.
+
+    ``report``, given, is called with one line saying which spacing was used.
+    """
+    from ..images import boundary_from_mask, read_image, surface_from_mask
+    from .csv_files import read_curve
+    from .meshes import SURFACE_SUFFIXES, read_surface
+
+    name = os.fspath(path)
+    if name.lower().endswith(SURFACE_SUFFIXES):
+        return read_surface(name), False
+    if not name.lower().endswith(IMAGE_SUFFIXES):
+        return read_curve(name), False
+    data, stated = read_image(name)
+    if data.ndim not in (2, 3):
+        raise ValueError(f"a {data.ndim}D image (shape {data.shape}): expected a 2D mask or a 3D stack")
+    if spacing is not None:
+        spacing, source = tuple(spacing) if hasattr(spacing, "__len__") else (spacing,), "--spacing"
+    elif stated is not None:
+        spacing, source = tuple(float(v) for v in stated), "the file"
+    else:
+        spacing, source = (1.0,), "no spacing in the file, none given"
+    if report is not None:
+        unit = "pixel" if data.ndim == 2 else "voxel"
+        report(f"{name}: {unit} spacing {' x '.join(f'{v:g}' for v in spacing)} ({source})")
+    if data.ndim == 2:
+        return boundary_from_mask(data, spacing, label=label, smooth=smooth), True
+    return surface_from_mask(data, spacing, label=label, smooth=smooth, edge_length=edge_length), True

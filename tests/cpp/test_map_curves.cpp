@@ -1,0 +1,167 @@
+// map_curves against closed forms and brute force, as the Python tests check it: normal rays onto
+// a circle, minimal distance against every segment, uniform's exact proportions, the split at
+// the four crossings of two ellipses, reverse, the automatic workflow, and named bad input.
+#include <morphomap/crossings.hpp>
+#include <morphomap/errors.hpp>
+#include <morphomap/mapping.hpp>
+
+#include "check.hpp"
+#include "shapes.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+using morphomap::CurveMappingOptions;
+using morphomap::DisplacementField2;
+using morphomap::Index;
+using morphomap::InvalidInput;
+using morphomap::MapMethod;
+using morphomap::map_curves;
+using morphomap::Method;
+using morphomap::Points2;
+using morphomap_test::pi;
+
+namespace {
+
+// n points counter-clockwise from angle `phase` on the ellipse with semi-axes a, b.
+Points2 ellipse(Index n, double a, double b, double phase = 0.0) {
+  Points2 p(n, 2);
+  for (Index i = 0; i < n; ++i) {
+    const double t = phase + 2 * pi * static_cast<double>(i) / static_cast<double>(n);
+    p.row(i) << a * std::cos(t), b * std::sin(t);
+  }
+  return p;
+}
+
+DisplacementField2 map(const Points2& c1, const Points2& c2, MapMethod method, bool reverse = false) {
+  CurveMappingOptions options;
+  options.method = method;
+  options.reverse = reverse;
+  return map_curves(c1, c2, options);
+}
+
+bool all_are(const DisplacementField2& field, Method method) {
+  return std::all_of(field.methods.begin(), field.methods.end(), [&](Method m) { return m == method; });
+}
+
+std::string message_of(const Points2& c1, const Points2& c2) {
+  try {
+    map(c1, c2, MapMethod::automatic);
+  } catch (const InvalidInput& error) {
+    return error.what();
+  }
+  return "";
+}
+
+void normal_rays_meet_the_outer_circle() {
+  // Radial normals of a regular 100-gon onto a 20000-gon of radius 2: each end lies on the ray
+  // through its start, within the polygon's sagitta of radius 2.
+  const Points2 c1 = ellipse(100, 1.0, 1.0), c2 = ellipse(20000, 2.0, 2.0);
+  const DisplacementField2 field = map(c1, c2, MapMethod::normal);
+  CHECK(field.size() == 100 && all_are(field, Method::normal));
+  const double sagitta = 2.0 * (1 - std::cos(pi / 20000));
+  for (Index i = 0; i < field.size(); ++i) {
+    CHECK(field.starts.row(i) == c1.row(i));
+    CHECK_NEAR(field.ends.row(i).norm(), 2.0, sagitta + 1e-12);
+    CHECK_NEAR(field.ends(i, 0) * c1(i, 1) - field.ends(i, 1) * c1(i, 0), 0.0, 1e-12);  // on the ray
+  }
+}
+
+void minimal_distance_equals_brute_force() {
+  const Points2 c1 = ellipse(100, 0.95, 0.95), c2 = ellipse(3000, 2.177, 1.0);
+  const DisplacementField2 field = map(c1, c2, MapMethod::minimal_distance);
+  CHECK(all_are(field, Method::minimal_distance));
+  for (Index i = 0; i < field.size(); ++i) {
+    double best = 1e300;
+    for (Index k = 0; k < c2.rows(); ++k) {
+      const Eigen::Vector2d a = c2.row(k), e = c2.row((k + 1) % c2.rows()) - c2.row(k);
+      const Eigen::Vector2d p = field.starts.row(i);
+      const double t = std::clamp((p - a).dot(e) / e.squaredNorm(), 0.0, 1.0);
+      best = std::min(best, (a + t * e - p).norm());
+    }
+    CHECK_NEAR((field.ends.row(i) - field.starts.row(i)).norm(), best, 1e-12);
+  }
+}
+
+void uniform_keeps_proportions() {
+  // Open lines: the arc-length fraction of each start point, exactly.
+  Points2 c1(11, 2), c2(7, 2);
+  for (Index i = 0; i < 11; ++i) c1.row(i) << i / 10.0, 0.0;
+  for (Index i = 0; i < 7; ++i) c2.row(i) << 3.0 * i / 6.0, 1.0;
+  CurveMappingOptions options;
+  options.method = MapMethod::uniform;
+  options.closed = false;
+  const DisplacementField2 open = map_curves(c1, c2, options);
+  for (Index i = 0; i < 11; ++i) {
+    CHECK_NEAR(open.ends(i, 0), 3.0 * i / 10.0, 1e-14);
+    CHECK_NEAR(open.ends(i, 1), 1.0, 1e-14);
+  }
+  // Closed: the same circle of radius 2 starting five points later; the best cyclic shift is the
+  // radial map.
+  const Points2 circle1 = ellipse(64, 1.0, 1.0), circle2 = ellipse(64, 2.0, 2.0, 2 * pi * 5 / 64);
+  const DisplacementField2 closed = map(circle1, circle2, MapMethod::uniform);
+  CHECK((closed.ends - 2.0 * circle1).cwiseAbs().maxCoeff() < 1e-12);
+}
+
+void split_ellipses_do_not_cross() {
+  // Ellipses 2 x 1 and 1 x 2 cross at (+-2/sqrt 5, +-2/sqrt 5): four fixed points are inserted.
+  const Points2 c1 = ellipse(400, 2.0, 1.0), c2 = ellipse(400, 1.0, 2.0);
+  for (MapMethod method : {MapMethod::minimal_distance, MapMethod::uniform}) {
+    const DisplacementField2 field = map(c1, c2, method);
+    CHECK(field.size() == 404);
+    int fixed = 0;
+    for (Index i = 0; i < field.size(); ++i) {
+      CHECK(field.valid(i));
+      if (field.starts.row(i) == field.ends.row(i)) {
+        ++fixed;
+        CHECK_NEAR(std::abs(field.starts(i, 0)), 2 / std::sqrt(5.0), 1e-4);  // polyline vs ellipse
+        CHECK_NEAR(std::abs(field.starts(i, 1)), 2 / std::sqrt(5.0), 1e-4);
+      }
+    }
+    CHECK(fixed == 4);
+    CHECK(morphomap::count_crossings(field.starts, field.ends) == 0);
+  }
+}
+
+void reverse_starts_on_c1_in_c2_order() {
+  const Points2 c1 = ellipse(50, 1.0, 1.0), c2 = ellipse(80, 2.0, 1.5);
+  const DisplacementField2 field = map(c1, c2, MapMethod::minimal_distance, true);
+  CHECK(field.size() == 80 && all_are(field, Method::reverse_minimal_distance));
+  CHECK(field.ends == c2);
+  for (Index i = 0; i < field.size(); ++i) CHECK_NEAR(field.starts.row(i).norm(), 1.0, 1 - std::cos(pi / 50));
+}
+
+void automatic_maps_concentric_circles_radially() {
+  // Algorithm 1: normal mapping has neither crossings nor misses here, so it is kept.
+  const Points2 c1 = ellipse(200, 1.0, 1.0), c2 = ellipse(2000, 1.5, 1.5);
+  const DisplacementField2 field = map(c1, c2, MapMethod::automatic);
+  CHECK(all_are(field, Method::normal));
+  CHECK(morphomap::count_crossings(field.starts, field.ends) == 0);
+  for (Index i = 0; i < field.size(); ++i) CHECK_NEAR(field.ends.row(i).norm(), 1.5, 1.5 * (1 - std::cos(pi / 2000)) + 1e-12);
+}
+
+void bad_curves_are_named() {
+  const Points2 eight = morphomap_test::pts({{0, 0}, {1, 1}, {1, 0}, {0, 1}});
+  const Points2 big = ellipse(40, 3.0, 3.0);
+  CHECK(message_of(eight, big).rfind("c1: the curve intersects itself", 0) == 0);
+  CHECK(message_of(big, eight).rfind("c2: the curve intersects itself", 0) == 0);
+  const Points2 flat = morphomap_test::pts({{0, 0}, {1, 0}, {2, 0}});
+  CHECK(message_of(flat, big).rfind("c1:", 0) == 0);
+  Points2 nan = big;
+  nan(3, 1) = std::nan("");
+  CHECK(message_of(big, nan).rfind("c2:", 0) == 0);
+}
+
+}  // namespace
+
+int main() {
+  normal_rays_meet_the_outer_circle();
+  minimal_distance_equals_brute_force();
+  uniform_keeps_proportions();
+  split_ellipses_do_not_cross();
+  reverse_starts_on_c1_in_c2_order();
+  automatic_maps_concentric_circles_radially();
+  bad_curves_are_named();
+  TEST_MAIN_END();
+}
