@@ -78,7 +78,7 @@ def test_fuzz_pairs(seed):
 def fake(name, qm, defects, misses):
     """A candidate job whose field and quality are given."""
     field = SimpleNamespace(valid=np.array([True] * 3 + [False] * misses), name=name,
-                            _with_candidates=lambda table: (name, table))
+                            _with_candidates=lambda table, pieces=None: (name, table))
     q = SimpleNamespace(qm1=qm, qm2=1.0, qm=qm, crossings=defects)
     return (name, lambda: field, lambda _: q)
 
