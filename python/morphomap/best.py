@@ -174,13 +174,12 @@ def _per_piece(results, split, c1, c2, closed):
     for field, _ in ran:
         start_piece, start_along = _core.piece_labels(split, field.starts, True)
         end_piece, end_along = _core.piece_labels(split, field.ends, False)
-        labels.append((np.asarray(start_piece), start_along, np.asarray(end_piece), end_along))
+        labels.append((np.asarray(start_piece), start_along, np.asarray(end_piece), end_along,
+                       np.isfinite(field.starts).all(axis=1), np.isfinite(field.ends).all(axis=1)))
     rows, chosen = [], []
     for p, piece in enumerate(split.pieces):
         scores = []
-        for (field, c), (sp, sa, ep, ea) in zip(ran, labels):
-            has_start = np.isfinite(field.starts).all(axis=1)
-            has_end = np.isfinite(field.ends).all(axis=1)
+        for (field, c), (sp, sa, ep, ea, has_start, has_end) in zip(ran, labels):
             own = (sp == p) | (~has_start & (ep == p))
             if (own & has_start & has_end & (ep != p) & (ep != -1)).any():
                 rows.append(PieceCandidate(p, c.name, math.nan, math.nan, math.nan, -1, -1, "leaves the piece"))
