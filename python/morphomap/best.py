@@ -275,7 +275,8 @@ def map_best(c1, c2, *, closed=True, n=None, split=True, anchor=None, density_th
 
 
 def map_best_surfaces(s1, s2, *, mesh_size=None, skip_below=None, workers=None):
-    """3D ``method="best"``: see the module's documentation. Called by :func:`map_surfaces`."""
+    """3D ``method="best"``: see the module's documentation; the pair is one subproblem (no
+    per-piece choice, no ``piece_candidates``). Called by :func:`map_surfaces`."""
     from .quality import quality
     from .surfaces import as_surface, map_surfaces
 
