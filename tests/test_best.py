@@ -266,3 +266,8 @@ def test_split_curves_is_the_split_map_curves_uses():
     assert len(_core.split_curves(c1, c2, True, True, -1.0).pieces) == 1
     field = mm.map_curves(c1, c2, "best", skip_below=10.0)
     assert field.piece_candidates == () and "per_piece" not in {c.name for c in field.candidates}
+    # Resampled, the candidates split other curves than the given ones: the choice is per pair.
+    c1, c2 = wavy_pair()
+    field = mm.map_curves(c1, c2, "best", n=150, skip_below=10.0)
+    assert field.piece_candidates == () and "per_piece" not in {c.name for c in field.candidates}
+    check_choice(field, c1, c2)

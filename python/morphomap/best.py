@@ -264,7 +264,7 @@ def map_best(c1, c2, *, closed=True, n=None, split=True, anchor=None, density_th
     expensive = [job(*row) for row in _plan(("diffusion",), (False, True))]
     results = _run_all(cheap, expensive, skip_below, workers)
     if n is not None:  # the candidates split the resampled curves: per pair (see above)
-        return _pick(results)
+        return _pick(results, ())
     c1, c2 = as_points(c1, "c1"), as_points(c2, "c2")
     split_at = _core.split_curves(c1, c2, closed, as_flag(split, "split"),
                                   as_length(contact_tolerance, "contact_tolerance", -1.0, allow_zero=True))
