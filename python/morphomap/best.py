@@ -263,7 +263,9 @@ def map_best(c1, c2, *, closed=True, n=None, split=True, anchor=None, density_th
     cheap += [job("optimal", "optimal"), job("auto", "auto")]
     expensive = [job(*row) for row in _plan(("diffusion",), (False, True))]
     results = _run_all(cheap, expensive, skip_below, workers)
-    if n is not None:  # the candidates split the resampled curves: per pair (see above)
+    # With n the candidates split the resampled curves: per pair (see above). Without any field
+    # _pick says why each candidate failed.
+    if n is not None or all(field is None for field, _ in results):
         return _pick(results, ())
     c1, c2 = as_points(c1, "c1"), as_points(c2, "c2")
     split_at = _core.split_curves(c1, c2, closed, as_flag(split, "split"),
