@@ -58,7 +58,7 @@ SKIP_BELOW = 1e-3
 class Candidate(NamedTuple):
     """One row of ``field.candidates``."""
 
-    name: str       # "normal", "reverse_normal", "transformed_diffusion", "optimal", "auto", ...
+    name: str       # "normal", "reverse_normal", "transformed_diffusion", "optimal", "auto", ..., "per_piece"
     qm1: float
     qm2: float
     qm: float

@@ -14,6 +14,7 @@
 #include "shapes.hpp"
 #include "surfaces.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -124,11 +125,12 @@ void split_curves_gives_the_bulge() {
   const Points2 c1 = bulging(360, 1.0), c2 = bulging(360, 1.5);
   const morphomap::CurveSplit split = morphomap::split_curves(c1, c2);
   CHECK(split.pieces.size() == 1);
+  if (split.pieces.size() != 1) return;
   const morphomap::CurvePiece& piece = split.pieces[0];
   CHECK(piece.begin_meeting && piece.end_meeting);
   // Inside the ends: the 159 vertices at |angle| < 80 degrees, radius 1 on C1 and 1.5 on C2.
   CHECK(piece.source.rows() == 161 && piece.target.rows() == 161);
-  for (Index i = 1; i + 1 < piece.source.rows(); ++i) {
+  for (Index i = 1; i + 1 < std::min(piece.source.rows(), piece.target.rows()); ++i) {
     CHECK_NEAR(piece.target.row(i).norm(), 1.5, 1e-12);
     CHECK(std::abs(std::atan2(piece.source(i, 1), piece.source(i, 0))) < 80.0 * pi / 180.0);
   }
