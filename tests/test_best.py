@@ -62,6 +62,8 @@ def check_pieces(field, c1, c2, closed):
     split = _core.split_curves(c1, c2, closed, True, -1.0)
     mine = np.asarray(_core.piece_labels(split, field.starts, True)[0])
     for k, name in winners.items():
+        # Every piece with points of C1 has vectors (the split points' own alone measure perfect).
+        assert (mine == k).any() or len(split.pieces[k].source) == 2
         theirs = candidate_field(c1, c2, name, closed=closed)
         labels = np.asarray(_core.piece_labels(split, theirs.starts, True)[0])
         np.testing.assert_array_equal(field.ends[mine == k], theirs.ends[labels == k])
@@ -90,6 +92,9 @@ def test_kidney_skips_diffusion_when_a_cheap_candidate_is_good_enough():
     skipped = {c.name for c in field.candidates if c.status.startswith("skipped")}
     assert skipped == {"diffusion", "reverse_diffusion", "transformed_diffusion", "transformed_reverse_diffusion"}
     winner = check_choice(field, c1, c2)
+    # The lobe of C1 outside C2 is a piece that the reverse minimal distance of the moved C1 leaves
+    # without vectors: it does not win there.
+    assert any(r.status == "no vectors" and r.misses > 0 for r in field.piece_candidates)
     assert winner.qm < 1.0
     # auto (QM about 40 here) is beaten by two orders of magnitude.
     assert winner.qm < 0.01 * next(c.qm for c in field.candidates if c.name == "auto")

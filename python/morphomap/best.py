@@ -13,7 +13,8 @@ piece every candidate's vectors from that stretch of C1 are measured on their ow
 between the two open pieces with the split points' own vectors at both ends: QM1, QM2, QM,
 crossings and misses (``field.piece_candidates``). A candidate whose vectors leave the piece (an
 end on another piece of C2: the transformed candidates split their moved C1 at other points) does
-not compete there. Each piece keeps its winner (the rule below); the winners' vectors, with the
+not compete there; one without any vector from the piece's points of C1 counts them as missed
+(``"no vectors"``). Each piece keeps its winner (the rule below); the winners' vectors, with the
 split points' own (from a forward candidate: a crossing onto itself, a contact stretch's points to
 their closest points), make the ``"per_piece"`` field, which is measured as a whole and competes
 with the whole-pair candidates by the same rule, so that a crossing between two pieces' winners or
@@ -78,7 +79,8 @@ class PieceCandidate(NamedTuple):
     qm: float
     defects: int    # crossings among the piece's vectors (with the split points' own)
     misses: int
-    status: str     # "won", "admissible", "crossings", "misses", "leaves the piece", "failed: <reason>"
+    status: str     # "won", "admissible", "crossings", "misses", "no vectors", "leaves the piece",
+                    # or "failed: <reason>"
 
 
 def _name(method: str, reverse: bool, transform: bool) -> str:
@@ -185,6 +187,13 @@ def _per_piece(results, split, c1, c2, closed):
                 rows.append(PieceCandidate(p, c.name, math.nan, math.nan, math.nan, -1, -1, "leaves the piece"))
                 continue
             members = np.flatnonzero(own)
+            # No vector from a stretch of C1 that has points (a reverse candidate whose points of C2
+            # all land elsewhere): the piece is not mapped, its points count as missed. (The two
+            # split points' own vectors alone would measure as a perfect field.)
+            unmapped = len(piece.source) - piece.begin_meeting - piece.end_meeting
+            if len(members) == 0 and unmapped > 0:
+                rows.append(PieceCandidate(p, c.name, math.nan, math.nan, math.nan, 0, unmapped, "no vectors"))
+                continue
             # Along the piece (a reverse miss by its point on C2, scaled to C1's piece).
             along = np.where(has_start[members], sa[members],
                              ea[members] * piece.source_length / max(piece.target_length, 1e-300))
