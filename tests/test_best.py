@@ -38,7 +38,36 @@ def check_choice(field, c1, c2, *, closed=True):
     crossing_free = [c for c in field.candidates if c.defects == 0]
     if crossing_free:
         assert q.crossings == 0
+    check_pieces(field, c1, c2, closed)
     return winner
+
+
+def check_pieces(field, c1, c2, closed):
+    """Each piece's winner is its admissible candidate of lowest QM; when the per-piece field won,
+    its vectors on each piece are that piece's winner's."""
+    from morphomap import _core
+
+    rows = field.piece_candidates or ()
+    winners = {}
+    for k in sorted({r.piece for r in rows}):
+        on_piece = [r for r in rows if r.piece == k]
+        won = [r for r in on_piece if r.status == "won"]
+        admissible = [r for r in on_piece if r.defects == 0 and r.misses == 0 and math.isfinite(r.qm)]
+        assert len(won) == 1
+        if admissible:
+            assert won[0] in admissible and won[0].qm == min(r.qm for r in admissible)
+        winners[k] = won[0].name
+    if next(c.name for c in field.candidates if c.status == "won") != "per_piece":
+        return
+    split = _core.split_curves(c1, c2, closed, True, -1.0)
+    mine = np.asarray(_core.piece_labels(split, field.starts, True)[0])
+    for k, name in winners.items():
+        # Every piece with points of C1 has vectors (the split points' own alone measure perfect).
+        assert (mine == k).any() or len(split.pieces[k].source) == 2
+        theirs = candidate_field(c1, c2, name, closed=closed)
+        labels = np.asarray(_core.piece_labels(split, theirs.starts, True)[0])
+        np.testing.assert_array_equal(field.ends[mine == k], theirs.ends[labels == k])
+        np.testing.assert_array_equal(field.method[mine == k], theirs.method[labels == k])
 
 
 def test_table1_pair_every_candidate():
@@ -63,12 +92,16 @@ def test_kidney_skips_diffusion_when_a_cheap_candidate_is_good_enough():
     skipped = {c.name for c in field.candidates if c.status.startswith("skipped")}
     assert skipped == {"diffusion", "reverse_diffusion", "transformed_diffusion", "transformed_reverse_diffusion"}
     winner = check_choice(field, c1, c2)
+    # The lobe of C1 outside C2 is a piece that the reverse minimal distance of the moved C1 leaves
+    # without vectors: it does not win there.
+    assert any(r.status == "no vectors" and r.misses > 0 for r in field.piece_candidates)
     assert winner.qm < 1.0
     # auto (QM about 40 here) is beaten by two orders of magnitude.
     assert winner.qm < 0.01 * next(c.qm for c in field.candidates if c.name == "auto")
 
 
-@pytest.mark.parametrize("seed", [0, 5])
+# 19: nine pieces between contact stretches, where the per-piece field wins.
+@pytest.mark.parametrize("seed", [0, 5, 19])
 def test_fuzz_pairs(seed):
     pair = frames.curve_pair(seed, "careful")
     field = mm.map_curves(pair.c1, pair.c2, "best", skip_below=10.0)
@@ -78,7 +111,7 @@ def test_fuzz_pairs(seed):
 def fake(name, qm, defects, misses):
     """A candidate job whose field and quality are given."""
     field = SimpleNamespace(valid=np.array([True] * 3 + [False] * misses), name=name,
-                            _with_candidates=lambda table: (name, table))
+                            _with_candidates=lambda table, pieces=None: (name, table))
     q = SimpleNamespace(qm1=qm, qm2=1.0, qm=qm, crossings=defects)
     return (name, lambda: field, lambda _: q)
 
@@ -136,3 +169,110 @@ def test_bad_input():
         mm.map_curves(c1, c2, "best", stretch_weight=-1.0)
     with pytest.raises(ValueError, match="density_threshold"):
         mm.map_curves(c1, c2, "best", density_threshold=0.0)
+
+
+def wavy_pair():
+    """A circle and a wavy curve crossing it 8 times: no one candidate is best on every piece."""
+    t = 2 * np.pi * np.arange(200) / 200
+    c1 = np.column_stack([np.cos(t), np.sin(t)])
+    r = 1 + 0.2 * np.sin(4 * t + 0.1) + 0.05 * np.sin(7 * t)
+    return c1, np.column_stack([r * np.cos(t), r * np.sin(t)])
+
+
+def vertex_arcs(curve):
+    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(curve, axis=0), axis=1))])
+
+
+def perimeter(curve):
+    return np.linalg.norm(np.diff(np.vstack([curve, curve[:1]]), axis=0), axis=1).sum()
+
+
+def candidate_field(c1, c2, name, closed=True):
+    """The field of the whole-pair candidate `name`, made again by map_curves."""
+    transform, name = name.startswith("transformed_"), name.removeprefix("transformed_")
+    reverse, name = name.startswith("reverse_"), name.removeprefix("reverse_")
+    return mm.map_curves(c1, c2, name, reverse=reverse, transform=transform, closed=closed)
+
+
+def test_per_piece_choice_against_pieces_built_from_the_crossings():
+    c1, c2 = wavy_pair()
+    field = mm.map_curves(c1, c2, "best", skip_below=10.0)  # (diffusion skipped: seconds)
+    check_choice(field, c1, c2)
+    # The pieces, independently: between consecutive crossings along C1 (both curves run
+    # anticlockwise), the vertices strictly between them plus the two crossing points.
+    points, s1, s2 = mm.curve_intersections(c1, c2, return_arc_lengths=True)
+    assert len(points) == 8
+    l1, l2 = perimeter(c1), perimeter(c2)
+    a1, a2 = vertex_arcs(c1), vertex_arcs(c2)
+
+    def inside(arcs, begin, end, length):
+        along = (arcs - begin) % length
+        return along, (along > 1e-9) & (along < (end - begin) % length - 1e-9)
+
+    def piece_of(field, k):
+        """The piece's own field between its two crossing points, with the open pieces of C1, C2."""
+        j = (k + 1) % 8
+        along, rows = inside(mm.closest_points(field.starts, c1).arc_lengths, s1[k], s1[j], l1)
+        rows = np.flatnonzero(rows)[np.argsort(along[rows])]
+        starts = np.vstack([points[k], field.starts[rows], points[j]])
+        ends = np.vstack([points[k], field.ends[rows], points[j]])
+        v1_along, v1 = inside(a1, s1[k], s1[j], l1)
+        v2_along, v2 = inside(a2, s2[k], s2[j], l2)
+        piece1 = np.vstack([points[k], c1[np.flatnonzero(v1)[np.argsort(v1_along[v1])]], points[j]])
+        piece2 = np.vstack([points[k], c2[np.flatnonzero(v2)[np.argsort(v2_along[v2])]], points[j]])
+        return mm.DisplacementField(starts, ends, "uniform"), piece1, piece2, rows
+
+    rows = field.piece_candidates
+    assert {r.piece for r in rows} == set(range(8))
+    fields = {}
+    for k in range(8):
+        on_piece = [r for r in rows if r.piece == k]
+        measured = [r for r in on_piece if r.defects >= 0]
+        won = [r for r in on_piece if r.status == "won"]
+        assert len(won) == 1 and won[0].defects == 0 and won[0].misses == 0
+        assert won[0].qm == min(r.qm for r in measured if r.defects == 0 and r.misses == 0)
+        for r in measured:  # each row against the piece measured here
+            if r.name not in fields:
+                fields[r.name] = candidate_field(c1, c2, r.name)
+            sub, piece1, piece2, _ = piece_of(fields[r.name], k)
+            q = mm.quality(sub, piece1, piece2, closed=False)
+            assert q.qm == pytest.approx(r.qm, rel=1e-9) and q.crossings == r.defects
+        # The returned field holds the winner's vectors on this piece.
+        mine, theirs = piece_of(field, k)[3], piece_of(fields[won[0].name], k)[3]
+        np.testing.assert_array_equal(field.ends[mine], fields[won[0].name].ends[theirs])
+    # Several candidates win pieces here, and their assembly beats every whole candidate.
+    assert len({r.name for r in rows if r.status == "won"}) >= 3
+    winner = next(c for c in field.candidates if c.status == "won")
+    assert winner.name == "per_piece"
+    assert winner.qm < min(c.qm for c in field.candidates if c.name != "per_piece" and c.defects == 0)
+    assert "per_piece" in candidate_table(field) and "leaves the piece" in candidate_table(field, pieces=True)
+
+
+def test_split_curves_is_the_split_map_curves_uses():
+    from morphomap import _core
+
+    c1, c2 = wavy_pair()
+    split = _core.split_curves(c1, c2, True, True, -1.0)
+    points = mm.curve_intersections(c1, c2)
+    assert len(split.pieces) == len(points) == 8
+    for k, piece in enumerate(split.pieces):
+        assert piece.begin_meeting and piece.end_meeting
+        np.testing.assert_allclose(piece.source[0], points[k], atol=1e-12)
+        np.testing.assert_allclose(piece.source[-1], points[(k + 1) % 8], atol=1e-12)
+        np.testing.assert_allclose(piece.target[[0, -1]], piece.source[[0, -1]], atol=1e-12)
+    # Every vertex of C1 is in exactly one piece, and is labelled with it.
+    inner = np.vstack([piece.source[1:-1] for piece in split.pieces])
+    assert len(inner) == len(c1) and len(np.unique(inner, axis=0)) == len(c1)
+    labels, _ = _core.piece_labels(split, np.vstack([piece.source for piece in split.pieces]), True)
+    expected = np.concatenate([[-1] + [k] * (len(piece.source) - 2) + [-1] for k, piece in enumerate(split.pieces)])
+    np.testing.assert_array_equal(labels, expected)
+    # Without split points the pair is one piece, and best makes no per-piece field.
+    c1, c2 = mm.load_example("circle_ellipse")
+    assert len(_core.split_curves(c1, c2, True, True, -1.0).pieces) == 1
+    field = mm.map_curves(c1, c2, "best", skip_below=10.0)
+    assert field.piece_candidates == () and "per_piece" not in {c.name for c in field.candidates}
+    # Resampled, the candidates split other curves than the given ones: the choice is per pair.
+    c1, c2 = wavy_pair()
+    field = mm.map_curves(c1, c2, "best", n=150, skip_below=10.0)
+    assert field.piece_candidates == () and "per_piece" not in {c.name for c in field.candidates}
+    check_choice(field, c1, c2)

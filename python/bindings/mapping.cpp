@@ -61,6 +61,38 @@ void bind_mapping(py::module_& m) {
       py::arg("mesh_fraction"), py::arg("stretch_weight") = kDefaultStretchWeight);
   m.attr("DEFAULT_STRETCH_WEIGHT") = kDefaultStretchWeight;
 
+  py::class_<CurvePiece>(m, "CurvePiece")
+      .def_readonly("source", &CurvePiece::source)
+      .def_readonly("target", &CurvePiece::target)
+      .def_readonly("begin_meeting", &CurvePiece::begin_meeting)
+      .def_readonly("end_meeting", &CurvePiece::end_meeting)
+      .def_readonly("source_begin", &CurvePiece::source_begin)
+      .def_readonly("source_length", &CurvePiece::source_length)
+      .def_readonly("target_begin", &CurvePiece::target_begin)
+      .def_readonly("target_length", &CurvePiece::target_length);
+  py::class_<CurveSplit>(m, "CurveSplit")
+      .def_readonly("pieces", &CurveSplit::pieces)
+      .def_readonly("closed", &CurveSplit::closed)
+      .def_readonly("direction", &CurveSplit::direction);
+  m.def(
+      "split_curves",
+      [](const Points2Ref& c1, const Points2Ref& c2, bool closed, bool split, double contact_tolerance) {
+        py::gil_scoped_release release;
+        return split_curves(c1, c2, closed, split, contact_tolerance);
+      },
+      py::arg("c1"), py::arg("c2"), py::arg("closed"), py::arg("split"), py::arg("contact_tolerance"));
+  m.def(
+      "piece_labels",
+      [](const CurveSplit& split, const Points2Ref& points, bool on_c1) {
+        PieceLabels labels;
+        {
+          py::gil_scoped_release release;
+          labels = piece_labels(split, points, on_c1);
+        }
+        return py::make_tuple(py::cast(labels.piece), std::move(labels.along));
+      },
+      py::arg("split"), py::arg("points"), py::arg("on_c1"));
+
   m.def(
       "solve_diffusion",
       [](const Points2Ref& source, const Points2Ref& target, bool closed, double mesh_size,

@@ -1,24 +1,40 @@
-"""``method="best"``: run every candidate mapping of a pair and keep the crossing-free, miss-free one
-with the lowest QM.
+"""``method="best"``: run every candidate mapping of a pair and keep, per subproblem, the
+crossing-free, miss-free one with the lowest QM.
 
 The candidates (2D, :func:`map_curves`): normal, minimal distance and diffusion mapping, each plain,
 reversed (``reverse=True``), transformed (``transform=True``) and both; ``"optimal"``; and
-``"auto"`` (the paper's Algorithm 1), so that the winner's QM is never above auto's when auto is
-admissible. 3D (:func:`map_surfaces`): normal, minimal distance and diffusion, plain and reversed,
-and ``"auto"``. Each candidate runs on the whole pair with the same options (splitting at
-crossings and contact stretches inside each candidate as usual); the choice is made per pair,
-not per pair of segments.
+``"auto"`` (the paper's Algorithm 1). 3D (:func:`map_surfaces`): normal, minimal distance and
+diffusion, plain and reversed, and ``"auto"``. Each candidate runs once on the whole pair with the
+same options (splitting at crossings and contact stretches inside it as usual).
+
+Subproblems (2D): the pieces between the split points at the curves' crossings and contact
+stretches, as ``map_curves`` splits them (the core's ``split_curves``: one rule for both). On each
+piece every candidate's vectors from that stretch of C1 are measured on their own, as a field
+between the two open pieces with the split points' own vectors at both ends: QM1, QM2, QM,
+crossings and misses (``field.piece_candidates``). A candidate whose vectors leave the piece (an
+end on another piece of C2: the transformed candidates split their moved C1 at other points) does
+not compete there; one without any vector from the piece's points of C1 counts them as missed
+(``"no vectors"``). Each piece keeps its winner (the rule below); the winners' vectors, with the
+split points' own (from a forward candidate: a crossing onto itself, a contact stretch's points to
+their closest points), make the ``"per_piece"`` field, which is measured as a whole and competes
+with the whole-pair candidates by the same rule, so that a crossing between two pieces' winners or
+a QM that the pieces' choice does not lower never wins over a whole candidate. Curves that do not
+meet are one piece (no ``"per_piece"`` row). With ``n`` the candidates split the resampled curves,
+whose crossings are not on the given ones: the choice is then per pair. In 3D the pair is one
+subproblem.
 
 Choice: a candidate is admissible when it has no crossings (folds in 3D), no misses and a finite
 QM; the admissible one with the lowest QM wins. When none is admissible, the one with the fewest
 crossings (folds), then the fewest misses, then the lowest QM wins, so a field with crossings is
-never returned while a crossing-free candidate exists.
+never returned while a crossing-free candidate exists. Ties go to the earlier row of the table
+(the whole-pair candidates before ``"per_piece"``). ``auto`` is a candidate, so the winner's QM is
+never above auto's when auto is admissible.
 
 Skip rule: the candidates that solve a diffusion problem cost seconds where the others cost
 milliseconds. The cheap ones run first; the diffusion candidates are skipped (``status`` says so)
-when an admissible cheap one already has ``QM <= skip_below`` (default 1e-3: a field that good is
-as good as the paper's best rows on its example by two orders of magnitude). ``skip_below=0``
-never skips.
+when an admissible cheap one already has ``QM <= skip_below`` over the whole pair (default 1e-3: a
+field that good is as good as the paper's best rows on its example by two orders of magnitude).
+``skip_below=0`` never skips.
 
 Candidates of one batch run in parallel threads (the core releases the GIL), ``workers`` at a time
 (default: the number of CPUs).
@@ -34,7 +50,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ._validate import as_count
+from ._validate import as_count, as_flag, as_length, as_points
 
 #: Default of ``skip_below``: see the module's documentation.
 SKIP_BELOW = 1e-3
@@ -43,7 +59,7 @@ SKIP_BELOW = 1e-3
 class Candidate(NamedTuple):
     """One row of ``field.candidates``."""
 
-    name: str       # "normal", "reverse_normal", "transformed_diffusion", "optimal", "auto", ...
+    name: str       # "normal", "reverse_normal", "transformed_diffusion", "optimal", "auto", ..., "per_piece"
     qm1: float
     qm2: float
     qm: float
@@ -51,6 +67,20 @@ class Candidate(NamedTuple):
     misses: int     # vectors without a target; -1 when not run
     seconds: float  # mapping and quality
     status: str     # "won", "admissible", "crossings", "misses", "skipped", or "failed: <reason>"
+
+
+class PieceCandidate(NamedTuple):
+    """One row of ``field.piece_candidates``: one candidate on one piece (2D)."""
+
+    piece: int      # index of the piece, in order along C1
+    name: str
+    qm1: float
+    qm2: float
+    qm: float
+    defects: int    # crossings among the piece's vectors (with the split points' own)
+    misses: int
+    status: str     # "won", "admissible", "crossings", "misses", "no vectors", "leaves the piece",
+                    # or "failed: <reason>"
 
 
 def _name(method: str, reverse: bool, transform: bool) -> str:
@@ -90,8 +120,8 @@ def _key(candidate: Candidate):
     return (candidate.defects, candidate.misses, qm)
 
 
-def _choose(cheap, expensive, skip_below, workers):
-    """Runs the batches, applies the skip rule, returns the winning field with the table."""
+def _run_all(cheap, expensive, skip_below, workers):
+    """Runs the batches and applies the skip rule: [(field or None, Candidate)] in table order."""
     skip_below = SKIP_BELOW if skip_below is None else float(skip_below)
     if not (skip_below >= 0 and math.isfinite(skip_below)):
         raise ValueError(f"skip_below: must be a finite number >= 0, got {skip_below}")
@@ -109,6 +139,11 @@ def _choose(cheap, expensive, skip_below, workers):
                         for name, _, _ in expensive]
         else:
             results += list(pool.map(_run, expensive))
+    return results
+
+
+def _pick(results, piece_rows=None):
+    """The winning field of [(field or None, Candidate)], carrying the table."""
     ran = [(field, c) for field, c in results if field is not None]
     if not ran:
         reasons = "; ".join(f"{c.name}: {c.status}" for _, c in results)
@@ -116,13 +151,110 @@ def _choose(cheap, expensive, skip_below, workers):
     winner = min(ran, key=lambda fc: _key(fc[1]))[1].name
     table = [c._replace(status="won") if c.name == winner else c for _, c in results]
     field = next(f for f, c in ran if c.name == winner)
-    return field._with_candidates(table)
+    return field._with_candidates(table, piece_rows)
+
+
+def _choose(cheap, expensive, skip_below, workers):
+    """Runs the batches, applies the skip rule, returns the winning field with the table."""
+    return _pick(_run_all(cheap, expensive, skip_below, workers))
+
+
+#: Forward, untransformed candidates: their vectors at the split points are the split's own.
+_FIXED_FROM = ("normal", "minimal_distance", "optimal", "auto")
+
+
+def _per_piece(results, split, c1, c2, closed):
+    """The per-piece choice: ((field, Candidate "per_piece") or None, [PieceCandidate])."""
+    from . import _core
+    from .field import DisplacementField
+    from .quality import quality
+    from .queries import closest_points
+
+    begin = time.perf_counter()
+    ran = [(field, c) for field, c in results if field is not None]
+    labels = []
+    for field, _ in ran:
+        start_piece, start_along = _core.piece_labels(split, field.starts, True)
+        end_piece, end_along = _core.piece_labels(split, field.ends, False)
+        labels.append((np.asarray(start_piece), start_along, np.asarray(end_piece), end_along,
+                       np.isfinite(field.starts).all(axis=1), np.isfinite(field.ends).all(axis=1)))
+    rows, chosen = [], []
+    for p, piece in enumerate(split.pieces):
+        scores = []
+        for (field, c), (sp, sa, ep, ea, has_start, has_end) in zip(ran, labels):
+            own = (sp == p) | (~has_start & (ep == p))
+            if (own & has_start & has_end & (ep != p) & (ep != -1)).any():
+                rows.append(PieceCandidate(p, c.name, math.nan, math.nan, math.nan, -1, -1, "leaves the piece"))
+                continue
+            members = np.flatnonzero(own)
+            # No vector from a stretch of C1 that has points (a reverse candidate whose points of C2
+            # all land elsewhere): the piece is not mapped, its points count as missed. (The two
+            # split points' own vectors alone would measure as a perfect field.)
+            unmapped = len(piece.source) - piece.begin_meeting - piece.end_meeting
+            if len(members) == 0 and unmapped > 0:
+                rows.append(PieceCandidate(p, c.name, math.nan, math.nan, math.nan, 0, unmapped, "no vectors"))
+                continue
+            # Along the piece (a reverse miss by its point on C2, scaled to C1's piece).
+            along = np.where(has_start[members], sa[members],
+                             ea[members] * piece.source_length / max(piece.target_length, 1e-300))
+            members = members[np.argsort(along, kind="stable")]
+            starts, ends = [field.starts[members]], [field.ends[members]]
+            if piece.begin_meeting:
+                starts.insert(0, piece.source[:1]), ends.insert(0, piece.target[:1])
+            if piece.end_meeting:
+                starts.append(piece.source[-1:]), ends.append(piece.target[-1:])
+            sub = DisplacementField(np.vstack(starts), np.vstack(ends), "uniform")
+            try:
+                q = quality(sub, piece.source, piece.target, closed=False)
+            except ValueError as error:
+                rows.append(PieceCandidate(p, c.name, math.nan, math.nan, math.nan, -1, -1,
+                                           f"failed: {str(error).splitlines()[0]}"))
+                continue
+            misses = int((~field.valid[members]).sum())
+            status = ("crossings" if q.crossings else "misses" if misses else
+                      "admissible" if math.isfinite(q.qm) else "failed: QM is NaN")
+            row = PieceCandidate(p, c.name, float(q.qm1), float(q.qm2), float(q.qm), int(q.crossings), misses, status)
+            rows.append(row)
+            scores.append((row, field, members))
+        if not scores:
+            return None, rows
+        row, field, members = min(scores, key=lambda s: _key(s[0]))
+        rows[rows.index(row)] = row._replace(status="won")
+        chosen.append((row.name, field, members))
+
+    # The split points' own vectors are the same in every forward, untransformed candidate: from
+    # the one that won the most pieces (the first on a tie).
+    forward = [(f, c.name) for f, c in ran if c.name in _FIXED_FROM]
+    if not forward:
+        return None, rows
+    wins = [name for name, _, _ in chosen]
+    fixed_field = max(forward, key=lambda fc: wins.count(fc[1]))[0]
+    sp = labels[[f for f, _ in ran].index(fixed_field)][0]
+    fixed = np.flatnonzero((sp == -1) & np.isfinite(fixed_field.starts).all(axis=1))
+    parts = [(fixed_field, fixed)] + [(field, members) for _, field, members in chosen]
+    starts = np.vstack([f.starts[m] for f, m in parts])
+    ends = np.vstack([f.ends[m] for f, m in parts])
+    method = np.concatenate([f.method[m] for f, m in parts])
+    # In the order of the start points along C1, as map_curves gives them (misses with no start last).
+    key = np.full(len(starts), np.inf)
+    found = np.isfinite(starts).all(axis=1)
+    key[found] = closest_points(starts[found], c1, closed=closed).arc_lengths
+    order = np.argsort(key, kind="stable")
+    field = DisplacementField(starts[order], ends[order], method[order], source=c1, closed=closed)
+    q = quality(field, c1, c2, closed=closed)
+    misses = int((~field.valid).sum())
+    status = ("crossings" if q.crossings else "misses" if misses else
+              "admissible" if math.isfinite(q.qm) else "failed: QM is NaN")
+    candidate = Candidate("per_piece", float(q.qm1), float(q.qm2), float(q.qm), int(q.crossings), misses,
+                          time.perf_counter() - begin, status)
+    return (field, candidate), rows
 
 
 def map_best(c1, c2, *, closed=True, n=None, split=True, anchor=None, density_threshold=None,
              contact_tolerance=None, mesh_size=None, mesh_fraction=0.02, stretch_weight=None,
              skip_below=None, workers=None):
     """2D ``method="best"``: see the module's documentation. Called by :func:`map_curves`."""
+    from . import _core
     from .mapping import map_curves
     from .quality import quality
 
@@ -139,11 +271,23 @@ def map_best(c1, c2, *, closed=True, n=None, split=True, anchor=None, density_th
     cheap = [job(*row) for row in _plan(("normal", "minimal_distance"), (False, True))]
     cheap += [job("optimal", "optimal"), job("auto", "auto")]
     expensive = [job(*row) for row in _plan(("diffusion",), (False, True))]
-    return _choose(cheap, expensive, skip_below, workers)
+    results = _run_all(cheap, expensive, skip_below, workers)
+    # With n the candidates split the resampled curves: per pair (see above). Without any field
+    # _pick says why each candidate failed.
+    if n is not None or all(field is None for field, _ in results):
+        return _pick(results, ())
+    c1, c2 = as_points(c1, "c1"), as_points(c2, "c2")
+    split_at = _core.split_curves(c1, c2, closed, as_flag(split, "split"),
+                                  as_length(contact_tolerance, "contact_tolerance", -1.0, allow_zero=True))
+    if len(split_at.pieces) < 2:
+        return _pick(results, ())
+    assembled, piece_rows = _per_piece(results, split_at, c1, c2, closed)
+    return _pick(results + ([assembled] if assembled else []), tuple(piece_rows))
 
 
 def map_best_surfaces(s1, s2, *, mesh_size=None, skip_below=None, workers=None):
-    """3D ``method="best"``: see the module's documentation. Called by :func:`map_surfaces`."""
+    """3D ``method="best"``: see the module's documentation; the pair is one subproblem (no
+    per-piece choice, no ``piece_candidates``). Called by :func:`map_surfaces`."""
     from .quality import quality
     from .surfaces import as_surface, map_surfaces
 
@@ -158,13 +302,20 @@ def map_best_surfaces(s1, s2, *, mesh_size=None, skip_below=None, workers=None):
     return _choose(cheap, expensive, skip_below, workers)
 
 
-def candidate_table(field) -> str:
-    """``field.candidates`` as an aligned text table (one line per candidate)."""
+def candidate_table(field, *, pieces=False) -> str:
+    """``field.candidates`` as an aligned text table (one line per candidate); with ``pieces=True``
+    ``field.piece_candidates`` (one line per candidate and piece)."""
     if field.candidates is None:
         raise ValueError("field: has no candidates (made by a method other than 'best')")
-    rows = [("candidate", "QM1", "QM2", "QM", "defects", "misses", "seconds", "status")]
-    for c in field.candidates:
-        rows.append((c.name, f"{c.qm1:.4g}", f"{c.qm2:.4g}", f"{c.qm:.4g}", str(c.defects), str(c.misses),
-                     f"{c.seconds:.3f}", c.status))
+    if pieces:
+        rows = [("piece", "candidate", "QM1", "QM2", "QM", "defects", "misses", "status")]
+        for c in field.piece_candidates or ():
+            rows.append((str(c.piece), c.name, f"{c.qm1:.4g}", f"{c.qm2:.4g}", f"{c.qm:.4g}", str(c.defects),
+                         str(c.misses), c.status))
+    else:
+        rows = [("candidate", "QM1", "QM2", "QM", "defects", "misses", "seconds", "status")]
+        for c in field.candidates:
+            rows.append((c.name, f"{c.qm1:.4g}", f"{c.qm2:.4g}", f"{c.qm:.4g}", str(c.defects), str(c.misses),
+                         f"{c.seconds:.3f}", c.status))
     widths = np.max([[len(x) for x in row] for row in rows], axis=0)
     return "\n".join("  ".join(x.ljust(w) for x, w in zip(row, widths)).rstrip() for row in rows)

@@ -41,6 +41,10 @@ class DisplacementField:
     candidates : tuple of Candidate or None
         ``method="best"`` only: every candidate it tried, with its quality, crossings (folds in
         3D), misses and seconds, and which one won (see :mod:`morphomap.best`); None otherwise.
+    piece_candidates : tuple of PieceCandidate or None
+        ``method="best"`` in 2D: every candidate on every piece between the curves' split points,
+        with the piece's winner (empty when the pair is one piece or ``n`` was given); None
+        otherwise.
     faces : (F, 3) int64 or None
         3D only: the connectivity of the start points.
     source : (N, 2) float or None
@@ -52,7 +56,7 @@ class DisplacementField:
     Vectors are in the order of the points of the curve or surface the algorithm mapped from.
     """
 
-    __slots__ = ("_starts", "_ends", "_method", "_faces", "_source", "_closed", "_candidates")
+    __slots__ = ("_starts", "_ends", "_method", "_faces", "_source", "_closed", "_candidates", "_piece_candidates")
 
     def __init__(self, starts, ends, method, faces=None, *, source=None, closed=True, candidates=None):
         starts = np.asarray(starts)
@@ -78,6 +82,7 @@ class DisplacementField:
         self._source = None if source is None else _frozen(as_points(source, "source", 2))
         self._closed = as_flag(closed, "closed")
         self._candidates = None if candidates is None else tuple(candidates)
+        self._piece_candidates = None
 
     @classmethod
     def _from_core(cls, starts, ends, methods, faces=None, **source):
@@ -120,10 +125,16 @@ class DisplacementField:
     def candidates(self):
         return self._candidates
 
-    def _with_candidates(self, candidates) -> "DisplacementField":
-        """The same field carrying the table of ``method="best"``."""
-        return DisplacementField(self._starts, self._ends, self._method, self._faces, source=self._source,
-                                 closed=self._closed, candidates=candidates)
+    @property
+    def piece_candidates(self):
+        return self._piece_candidates
+
+    def _with_candidates(self, candidates, piece_candidates=None) -> "DisplacementField":
+        """The same field carrying the tables of ``method="best"``."""
+        field = DisplacementField(self._starts, self._ends, self._method, self._faces, source=self._source,
+                                  closed=self._closed, candidates=candidates)
+        field._piece_candidates = None if piece_candidates is None else tuple(piece_candidates)
+        return field
 
     def at(self, points, source=None, *, closed=None, return_distances=False):
         """The displacement at ``points`` of the source boundary, whatever made the field.

@@ -59,13 +59,20 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
         (g^2: the mean squared distance from the start points to C2; the second sum is the
         paper's QM1 term over consecutive vectors). The ends are chosen among 4 to 8 equally
         spaced positions on C2 per start point (the matching's resolution); coarse to fine, so
-        that 10^4 points per curve take well under a second. See ``monotone_match`` in the C++
+        that 10^4 points per curve take well under a second. Guaranteed: the order (the ends run
+        along C2 in the order of the start points, every part of it reached); crossings are
+        avoided where the matching can (each vector against the three before it), and none can
+        occur where every vector lies in the region between its two pieces; they are not
+        excluded in general (none measured: bench/README.md). See ``monotone_match`` in the C++
         header ``morphomap/optimal.hpp``.
         ``"best"`` (beyond the paper): runs every candidate — normal, minimal distance, diffusion,
-        each plain, reversed, transformed and both, ``"optimal"`` and ``"auto"`` — and returns
-        the one without crossings or misses of lowest QM (:func:`morphomap.best.map_best`);
-        ``field.candidates`` is the table of them all, ``field.method`` names the winner's
-        algorithm per vector.
+        each plain, reversed, transformed and both, ``"optimal"`` and ``"auto"`` — and keeps, on
+        each piece between the split points (as above), the one without crossings or misses of
+        lowest QM there; the pieces' winners together (``"per_piece"``) compete with the whole
+        candidates, and the field without crossings or misses of lowest QM is returned (see
+        :mod:`morphomap.best`). ``field.candidates`` is the table of the whole candidates,
+        ``field.piece_candidates`` that per piece, ``field.method`` names the algorithm of each
+        vector.
     n : int, optional
         Resample both curves to ``n`` equally spaced points first (linear, the paper's
         preprocessing); by default the given points of the source curve are the start points.

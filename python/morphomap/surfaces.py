@@ -112,7 +112,8 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None, skip
         then starts from the vertices of ``s2``; ``field.method`` tells).
         ``"best"`` (beyond the paper): normal, minimal distance and diffusion, each plain and
         reversed, and ``"auto"``; the one without folds or misses of lowest QM, with the table
-        of them all in ``field.candidates`` (:func:`morphomap.best.map_best_surfaces`).
+        of them all in ``field.candidates`` (:func:`morphomap.best.map_best_surfaces`). The pair
+        of surfaces is one subproblem: the choice is per pair, not per piece as in 2D.
     reverse : bool
         Map S2 -> S1 with the chosen algorithm and flip the vectors: starts lie on S1, ends on S2,
         in the order of S2's vertices, and ``field.faces`` are S2's faces.

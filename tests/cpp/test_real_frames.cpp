@@ -14,6 +14,7 @@
 #include "shapes.hpp"
 #include "surfaces.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -116,6 +117,30 @@ void touching_circles_are_a_split() {
     for (Index i = 1; i < field.size(); ++i) repeated += field.ends.row(i) == field.ends.row(i - 1) ? 1 : 0;
     CHECK(repeated == 0);
   }
+}
+
+// split_curves gives the pieces the mapping maps one by one: here the bulge, between the two ends
+// of the shared stretch; piece_labels puts each point in it or at the split.
+void split_curves_gives_the_bulge() {
+  const Points2 c1 = bulging(360, 1.0), c2 = bulging(360, 1.5);
+  const morphomap::CurveSplit split = morphomap::split_curves(c1, c2);
+  CHECK(split.pieces.size() == 1);
+  if (split.pieces.size() != 1) return;
+  const morphomap::CurvePiece& piece = split.pieces[0];
+  CHECK(piece.begin_meeting && piece.end_meeting);
+  // Inside the ends: the 159 vertices at |angle| < 80 degrees, radius 1 on C1 and 1.5 on C2.
+  CHECK(piece.source.rows() == 161 && piece.target.rows() == 161);
+  for (Index i = 1; i + 1 < std::min(piece.source.rows(), piece.target.rows()); ++i) {
+    CHECK_NEAR(piece.target.row(i).norm(), 1.5, 1e-12);
+    CHECK(std::abs(std::atan2(piece.source(i, 1), piece.source(i, 0))) < 80.0 * pi / 180.0);
+  }
+  const morphomap::PieceLabels on_c1 = morphomap::piece_labels(split, c1, true);
+  const morphomap::PieceLabels on_c2 = morphomap::piece_labels(split, c2, false);
+  for (Index i = 0; i < 360; ++i) {
+    const bool bulge = std::cos(2 * pi * i / 360) > std::cos(80.0 * pi / 180.0);
+    CHECK(on_c1.piece[i] == (bulge ? 0 : -1) && on_c2.piece[i] == (bulge ? 0 : -1));
+  }
+  CHECK_THROWS(morphomap::split_curves(c1, c2, true, true, std::nan("")), InvalidInput);
 }
 
 std::string message_of(const Points2& c1, const Points2& c2, MapMethod method) {
@@ -225,6 +250,7 @@ void an_interrupt_stops_a_mapping() {
 int main() {
   shared_stretch_is_a_split();
   touching_circles_are_a_split();
+  split_curves_gives_the_bulge();
   several_loops_and_self_intersections_are_named();
   debris_inward_and_unused_vertices_are_named();
   surfaces_that_coincide_over_a_patch_map();

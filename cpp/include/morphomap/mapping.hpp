@@ -6,6 +6,7 @@
 #include <morphomap/types.hpp>
 
 #include <optional>
+#include <vector>
 
 namespace morphomap {
 
@@ -47,5 +48,36 @@ struct CurveMappingOptions {
 // curves cut their corners).
 DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2,
                               const CurveMappingOptions& options = {});
+
+// One subproblem of a pair: the stretch of C1 between two consecutive split points (crossings when
+// splitting, contact stretches always; or an end of open curves) and the stretch of C2 between
+// the same two, as open polylines: source runs from the first split point through the vertices of
+// C1 it maps to the second, target between the same points in the source's direction.
+struct CurvePiece {
+  Points2 source, target;
+  bool begin_meeting = false, end_meeting = false;  // the ends are split points (else curve ends)
+  double source_begin = 0.0, source_length = 0.0;   // arc position on C1 where it begins, its length
+  double target_begin = 0.0, target_length = 0.0;   // on C2, walking in the pair's direction
+};
+
+// The pieces map_curves maps one by one (the same rule, one owner): in order along C1; without
+// split points one piece, the whole pair. c1 and c2 as the pieces' arc positions refer to them.
+struct CurveSplit {
+  std::vector<CurvePiece> pieces;
+  Points2 c1, c2;
+  bool closed = true;
+  int direction = 1;  // +1 when C2 runs the same way round as C1 (closed), else -1
+};
+CurveSplit split_curves(const Points2Ref& c1, const Points2Ref& c2, bool closed = true, bool split = true,
+                        double contact_tolerance = -1.0);
+
+// For points on C1 (on_c1) or on C2: the piece whose open stretch holds each one's closest curve
+// point (-1 at a split point, within rounding, and for rows with a NaN), and its distance along
+// the piece from the piece's beginning.
+struct PieceLabels {
+  std::vector<Index> piece;
+  Vector along;
+};
+PieceLabels piece_labels(const CurveSplit& split, const Points2Ref& points, bool on_c1);
 
 }  // namespace morphomap

@@ -24,6 +24,8 @@
 #include <cmath>
 #include <complex>
 #include <limits>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 namespace morphomap {
@@ -399,6 +401,128 @@ Vectors gather(std::vector<Vectors>& parts) {
   return all;
 }
 
+// One end of a piece: a meeting's end, or an end of open curves.
+struct End {
+  double s, t;  // arc positions on source and target
+  Vec2 p, q;    // the points there
+  bool meeting;
+};
+
+// Where a pair splits: the one rule behind the mapping and split_curves. The meetings kept (none:
+// the whole curves map as one), the pieces between them, the source rows each piece maps (in
+// order along it) and the rows on contact stretches; a row that is (within rounding) a crossing
+// belongs to no piece, as the crossings map onto themselves.
+struct Split {
+  CurveIntersections crossings;
+  std::vector<Meeting> meetings;
+  std::vector<std::pair<End, End>> pieces;
+  std::vector<std::vector<Index>> members;
+  std::vector<char> on_stretch;
+};
+
+Split split_pair(const ArcCurve& source, const ArcCurve& target, bool closed, bool split, bool find_crossings,
+                 double contact_tolerance, int direction) {
+  Split out;
+  const Index n = source.size();
+  out.on_stretch.assign(n, 0);
+  if (split || find_crossings) out.crossings = curve_intersections(source.points(), target.points(), closed);
+  // Where the curves meet: the crossings (when splitting) and, always, the stretches where they
+  // touch or run together, which no region between them spans.
+  const double tolerance =
+      contact_tolerance >= 0.0 ? contact_tolerance : detail::default_contact_tolerance(source, target);
+  const std::vector<Meeting> found =
+      detail::find_meetings(source, target, split ? out.crossings : CurveIntersections(), tolerance);
+  bool in_order = true;
+  std::vector<Meeting> meetings = detail::meetings_in_order(found, target, direction, &in_order);
+  const bool contact = std::any_of(found.begin(), found.end(), [](const Meeting& m) { return !m.crossing; });
+  // Crossings alone that do not pair up in order: map the whole curves (diffusion handles
+  // crossing curves as one region).
+  if (!in_order && !contact) meetings.clear();
+  // A closed pair that meets at one point only has no two pieces to pair: the piece between the
+  // point and itself would be the whole curve onto a point of the target. Map the whole curves.
+  if (closed && meetings.size() == 1 && meetings[0].source_begin == meetings[0].source_end) meetings.clear();
+  out.meetings = meetings;
+  if (meetings.empty()) return out;
+
+  // Each piece runs from the end of one meeting to the start of the next (open curves also from
+  // their start to the first and from the last to their end) and maps onto the target between
+  // the same two meetings.
+  const Index count = static_cast<Index>(meetings.size());
+  auto begin_of = [&](const Meeting& m, double shift) {
+    return End{m.source_begin + shift, m.target_begin, m.source_point_begin, m.target_point_begin, true};
+  };
+  auto end_of = [&](const Meeting& m) {
+    return End{m.source_end, m.target_end, m.source_point_end, m.target_point_end, true};
+  };
+  if (closed) {
+    for (Index p = 0; p < count; ++p) {
+      out.pieces.emplace_back(end_of(meetings[p]),
+                              begin_of(meetings[(p + 1) % count], p + 1 == count ? source.length() : 0.0));
+    }
+  } else {
+    const Index last = n - 1;
+    out.pieces.emplace_back(End{0.0, 0.0, source.points().row(0).transpose(), target.points().row(0).transpose(), false},
+                            begin_of(meetings[0], 0.0));
+    for (Index p = 0; p + 1 < count; ++p) out.pieces.emplace_back(end_of(meetings[p]), begin_of(meetings[p + 1], 0.0));
+    out.pieces.emplace_back(end_of(meetings[count - 1]),
+                            End{source.length(), target.length(), source.points().row(last).transpose(),
+                                target.points().row(target.size() - 1).transpose(), false});
+  }
+  for (const Meeting& m : meetings) {
+    if (m.crossing) continue;
+    for (Index v = m.first_vertex;; v = (v + 1) % n) {
+      out.on_stretch[v] = 1;
+      if (v == m.last_vertex) break;
+    }
+  }
+  // Each other source point goes to the piece it lies in; a point that is (within rounding) a
+  // crossing stays where it is, as the crossings do.
+  const double coincident = 1e-12 * source.length();
+  std::vector<double> begins(count);
+  for (Index p = 0; p < count; ++p) begins[p] = meetings[p].source_begin;
+  out.members.resize(out.pieces.size());
+  for (Index i = 0; i < n; ++i) {
+    if (out.on_stretch[i]) continue;
+    const double s = source.arc(i);
+    const Index after = std::upper_bound(begins.begin(), begins.end(), s) - begins.begin();
+    bool on_crossing = false;
+    for (Index c : {after - 1, after}) {
+      if (c >= 0 && c < count && meetings[c].crossing && source.between(s, meetings[c].source_begin) <= coincident) {
+        on_crossing = true;
+      }
+    }
+    if (on_crossing) continue;
+    out.members[closed ? (after == 0 ? count - 1 : after - 1) : after].push_back(i);
+  }
+  // Along the piece: the closing piece of a closed curve wraps past the first point.
+  for (std::size_t p = 0; p < out.pieces.size(); ++p) {
+    const double from = out.pieces[p].first.s;
+    std::stable_sort(out.members[p].begin(), out.members[p].end(), [&](Index a, Index b) {
+      return source.forward(from, source.arc(a)) < source.forward(from, source.arc(b));
+    });
+  }
+  return out;
+}
+
+// The open polylines of piece p as its job maps them: the source from one end through its member
+// rows to the other, the target between the same two ends, walked in the source's direction.
+std::pair<Points2, Points2> piece_polylines(const ArcCurve& source, const ArcCurve& target, const Split& split,
+                                            std::size_t p, int direction) {
+  const End &from = split.pieces[p].first, &to = split.pieces[p].second;
+  const std::vector<Index>& m = split.members[p];
+  const Index offset = from.meeting ? 1 : 0;
+  Points2 piece_source(offset + m.size() + (to.meeting ? 1 : 0), 2);
+  if (from.meeting) piece_source.row(0) = from.p.transpose();
+  for (std::size_t j = 0; j < m.size(); ++j) piece_source.row(offset + j) = source.points().row(m[j]);
+  if (to.meeting) piece_source.row(piece_source.rows() - 1) = to.p.transpose();
+  Points2 piece_target = source.closed() && direction < 0 ? Points2(target.piece(to.t, from.t).colwise().reverse())
+                                                          : target.piece(from.t, to.t);
+  // The pieces end exactly at the meetings (the target's are found by arc length).
+  if (from.meeting) piece_target.row(0) = from.q.transpose();
+  if (to.meeting) piece_target.row(piece_target.rows() - 1) = to.q.transpose();
+  return {std::move(piece_source), std::move(piece_target)};
+}
+
 Vectors map_directed(const Points2& source_points, const Points2& target_points, MapMethod method,
                      bool closed, bool split, const std::optional<std::pair<Vec2, Vec2>>& anchors,
                      const Settings& settings) {
@@ -409,26 +533,11 @@ Vectors map_directed(const Points2& source_points, const Points2& target_points,
   const Points2 source_normals = wants_normals ? normals(source.points(), closed) : Points2();
   const int direction = closed ? relative_direction(source, target) : 1;
 
-  CurveIntersections crossings;
-  if (split || (closed && method == MapMethod::uniform)) {
-    crossings = curve_intersections(source.points(), target.points(), closed);
-  }
+  const Split pieces_of = split_pair(source, target, closed, split, closed && method == MapMethod::uniform,
+                                     settings.contact_tolerance, direction);
+  const CurveIntersections& crossings = pieces_of.crossings;
   const Index k = crossings.points.rows();
-  // Where the curves meet: the crossings (when splitting) and, always, the stretches where they
-  // touch or run together, which no region between them spans.
-  const double tolerance = settings.contact_tolerance >= 0.0 ? settings.contact_tolerance
-                                                             : detail::default_contact_tolerance(source, target);
-  const std::vector<Meeting> found =
-      detail::find_meetings(source, target, split ? crossings : CurveIntersections(), tolerance);
-  bool in_order = true;
-  std::vector<Meeting> meetings = detail::meetings_in_order(found, target, direction, &in_order);
-  const bool contact = std::any_of(found.begin(), found.end(), [](const Meeting& m) { return !m.crossing; });
-  // Crossings alone that do not pair up in order: map the whole curves (diffusion handles
-  // crossing curves as one region).
-  if (!in_order && !contact) meetings.clear();
-  // A closed pair that meets at one point only has no two pieces to pair: the piece between the
-  // point and itself would be the whole curve onto a point of the target. Map the whole curves.
-  if (closed && meetings.size() == 1 && meetings[0].source_begin == meetings[0].source_end) meetings.clear();
+  const std::vector<Meeting>& meetings = pieces_of.meetings;
 
   auto add_starts = [&](Job& job, const std::vector<Index>& points, Index first_row) {
     for (std::size_t j = 0; j < points.size(); ++j) job.start_rows.push_back(first_row + j);
@@ -469,57 +578,22 @@ Vectors map_directed(const Points2& source_points, const Points2& target_points,
     return gather(parts);
   }
 
-  // Split: each piece runs from the end of one meeting to the start of the next (open curves also
-  // from their start to the first and from the last to their end) and maps onto the target
-  // between the same two meetings. A crossing maps onto itself and is a start point of its own;
-  // the source points on a contact stretch map to their closest point on the target.
-  const Index count = static_cast<Index>(meetings.size());
-  struct End {
-    double s, t;  // arc positions on source and target
-    Vec2 p, q;    // the points there
-    bool meeting;
-  };
-  std::vector<std::pair<End, End>> pieces;
-  auto begin_of = [&](const Meeting& m, double shift) {
-    return End{m.source_begin + shift, m.target_begin, m.source_point_begin, m.target_point_begin, true};
-  };
-  auto end_of = [&](const Meeting& m) {
-    return End{m.source_end, m.target_end, m.source_point_end, m.target_point_end, true};
-  };
-  if (closed) {
-    for (Index p = 0; p < count; ++p) {
-      pieces.emplace_back(end_of(meetings[p]), begin_of(meetings[(p + 1) % count], p + 1 == count ? source.length() : 0.0));
-    }
-  } else {
-    const Index last = n - 1;
-    pieces.emplace_back(End{0.0, 0.0, source.points().row(0).transpose(), target.points().row(0).transpose(), false},
-                        begin_of(meetings[0], 0.0));
-    for (Index p = 0; p + 1 < count; ++p) pieces.emplace_back(end_of(meetings[p]), begin_of(meetings[p + 1], 0.0));
-    pieces.emplace_back(end_of(meetings[count - 1]),
-                        End{source.length(), target.length(), source.points().row(last).transpose(),
-                            target.points().row(target.size() - 1).transpose(), false});
-  }
-
+  // Split (split_pair): a crossing maps onto itself and is a start point of its own; the source
+  // points on a contact stretch map to their closest point on the target; each piece maps on its
+  // own.
   std::vector<Vectors> parts(1);
   Vectors& fixed = parts[0];
-  std::vector<char> on_stretch(n, 0);
   std::vector<Vec2> fixed_starts, fixed_ends;
   std::vector<Method> fixed_methods;
   const Method crossing_method = basic_method(method == MapMethod::automatic ? MapMethod::normal : method);
   for (const Meeting& m : meetings) {
-    if (m.crossing) {
-      fixed_starts.push_back(m.source_point_begin), fixed_ends.push_back(m.source_point_begin);
-      fixed.keys.push_back(m.source_begin), fixed_methods.push_back(crossing_method);
-      continue;
-    }
-    for (Index v = m.first_vertex;; v = (v + 1) % n) {
-      on_stretch[v] = 1;
-      if (v == m.last_vertex) break;
-    }
+    if (!m.crossing) continue;
+    fixed_starts.push_back(m.source_point_begin), fixed_ends.push_back(m.source_point_begin);
+    fixed.keys.push_back(m.source_begin), fixed_methods.push_back(crossing_method);
   }
   std::vector<Index> stretch_rows;
   for (Index i = 0; i < n; ++i) {
-    if (on_stretch[i]) stretch_rows.push_back(i);
+    if (pieces_of.on_stretch[i]) stretch_rows.push_back(i);
   }
   if (!stretch_rows.empty()) {
     const Points2 queries = source.points()(stretch_rows, Eigen::all);
@@ -536,46 +610,14 @@ Vectors map_directed(const Points2& source_points, const Points2& target_points,
   }
   fixed.methods = std::move(fixed_methods);
 
-  // Each other source point goes to the piece it lies in; a point that is (within rounding) a
-  // crossing stays where it is, as the crossings do.
-  const double coincident = 1e-12 * source.length();
-  std::vector<double> begins(count);
-  for (Index p = 0; p < count; ++p) begins[p] = meetings[p].source_begin;
-  std::vector<std::vector<Index>> members(pieces.size());
-  for (Index i = 0; i < n; ++i) {
-    if (on_stretch[i]) continue;
-    const double s = source.arc(i);
-    const Index after = std::upper_bound(begins.begin(), begins.end(), s) - begins.begin();
-    bool on_crossing = false;
-    for (Index c : {after - 1, after}) {
-      if (c >= 0 && c < count && meetings[c].crossing && source.between(s, meetings[c].source_begin) <= coincident) {
-        on_crossing = true;
-      }
-    }
-    if (on_crossing) continue;
-    members[closed ? (after == 0 ? count - 1 : after - 1) : after].push_back(i);
-  }
-
-  for (std::size_t p = 0; p < pieces.size(); ++p) {
-    std::vector<Index>& m = members[p];
+  for (std::size_t p = 0; p < pieces_of.pieces.size(); ++p) {
+    const std::vector<Index>& m = pieces_of.members[p];
     if (m.empty()) continue;
-    const End &from = pieces[p].first, &to = pieces[p].second;
-    // Along the piece: the closing piece of a closed curve wraps past the first point.
-    std::stable_sort(m.begin(), m.end(), [&](Index a, Index b) {
-      return source.forward(from.s, source.arc(a)) < source.forward(from.s, source.arc(b));
-    });
+    const End &from = pieces_of.pieces[p].first, &to = pieces_of.pieces[p].second;
     Job job;
-    const Index offset = from.meeting ? 1 : 0;
-    job.source.resize(offset + m.size() + (to.meeting ? 1 : 0), 2);
-    if (from.meeting) job.source.row(0) = from.p.transpose();
-    for (std::size_t j = 0; j < m.size(); ++j) job.source.row(offset + j) = source.points().row(m[j]);
-    if (to.meeting) job.source.row(job.source.rows() - 1) = to.p.transpose();
-    add_starts(job, m, offset);
+    std::tie(job.source, job.target) = piece_polylines(source, target, pieces_of, p, direction);
+    add_starts(job, m, from.meeting ? 1 : 0);
     job.shared_begin = from.meeting, job.shared_end = to.meeting;
-    job.target = closed && direction < 0 ? Points2(target.piece(to.t, from.t).colwise().reverse()) : target.piece(from.t, to.t);
-    // The pieces end exactly at the meetings (the target's are found by arc length).
-    if (from.meeting) job.target.row(0) = from.q.transpose();
-    if (to.meeting) job.target.row(job.target.rows() - 1) = to.q.transpose();
     if (method == MapMethod::uniform) {
       const double length = to.s - from.s;
       job.fractions.resize(m.size());
@@ -672,6 +714,83 @@ DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2,
     project_onto(field.ends, c2.topRows(n2), closed);
   }
   return field;
+}
+
+CurveSplit split_curves(const Points2Ref& c1, const Points2Ref& c2, bool closed, bool split,
+                        double contact_tolerance) {
+  const Index n1 = detail::require_simple_curve(c1, closed, "c1");
+  const Index n2 = detail::require_simple_curve(c2, closed, "c2");
+  if (std::isnan(contact_tolerance) || std::isinf(contact_tolerance)) {
+    detail::invalid("contact_tolerance", "must be a finite length >= 0, or negative for the default");
+  }
+  const ArcCurve source(c1.topRows(n1), closed, "c1");
+  const ArcCurve target(c2.topRows(n2), closed, "c2");
+  const int direction = closed ? relative_direction(source, target) : 1;
+  const Split found = split_pair(source, target, closed, split, false, contact_tolerance, direction);
+  CurveSplit out;
+  out.c1 = source.points(), out.c2 = target.points();
+  out.closed = closed;
+  out.direction = direction;
+  if (found.meetings.empty()) {  // one piece: the whole pair
+    CurvePiece whole;
+    whole.source = source.points(), whole.target = target.points();
+    whole.source_length = source.length(), whole.target_length = target.length();
+    out.pieces.push_back(std::move(whole));
+    return out;
+  }
+  for (std::size_t p = 0; p < found.pieces.size(); ++p) {
+    const End &from = found.pieces[p].first, &to = found.pieces[p].second;
+    CurvePiece piece;
+    std::tie(piece.source, piece.target) = piece_polylines(source, target, found, p, direction);
+    piece.begin_meeting = from.meeting, piece.end_meeting = to.meeting;
+    piece.source_begin = source.wrap(from.s), piece.source_length = to.s - from.s;
+    piece.target_begin = target.wrap(from.t);
+    piece.target_length = !closed ? to.t - from.t : direction > 0 ? target.forward(from.t, to.t) : target.forward(to.t, from.t);
+    out.pieces.push_back(std::move(piece));
+  }
+  return out;
+}
+
+PieceLabels piece_labels(const CurveSplit& split, const Points2Ref& points, bool on_c1) {
+  if (points.cols() != 2) detail::invalid("points", "expected 2 columns");
+  const ArcCurve curve(on_c1 ? split.c1 : split.c2, split.closed, on_c1 ? "c1" : "c2");
+  PieceLabels labels;
+  labels.piece.assign(points.rows(), -1);
+  labels.along = Vector::Constant(points.rows(), kNaN);
+  std::vector<Index> rows;
+  for (Index i = 0; i < points.rows(); ++i) {
+    if (points.row(i).allFinite()) rows.push_back(i);
+  }
+  if (rows.empty()) return labels;
+  const Points2 queries = points(rows, Eigen::all);
+  const Vector arcs = CurveIndex(curve.points(), split.closed).closest_points(queries).arc_lengths;
+  // Within rounding of a meeting point is at the meeting (the crossings' own vectors lie there).
+  const double coincident = 1e-12 * curve.length();
+  const bool whole = split.pieces.size() == 1 && !split.pieces[0].begin_meeting && !split.pieces[0].end_meeting;
+  for (std::size_t j = 0; j < rows.size(); ++j) {
+    for (std::size_t p = 0; p < split.pieces.size(); ++p) {
+      const CurvePiece& piece = split.pieces[p];
+      const double begin = on_c1 ? piece.source_begin : piece.target_begin;
+      const double length = on_c1 ? piece.source_length : piece.target_length;
+      const int way = on_c1 ? 1 : split.direction;
+      double along = 0.0;
+      if (whole) {
+        along = split.closed && way < 0 ? curve.forward(arcs[j], 0.0) : arcs[j];
+      } else if (split.closed) {
+        along = way > 0 ? curve.forward(begin, arcs[j]) : curve.forward(arcs[j], begin);
+      } else {
+        along = arcs[j] - begin;
+      }
+      const bool after_begin = piece.begin_meeting ? along > coincident : along >= -coincident;
+      const bool before_end = piece.end_meeting ? along < length - coincident : along <= length + coincident;
+      if (whole || (after_begin && before_end)) {
+        labels.piece[rows[j]] = static_cast<Index>(p);
+        labels.along[rows[j]] = along;
+        break;
+      }
+    }
+  }
+  return labels;
 }
 
 }  // namespace morphomap

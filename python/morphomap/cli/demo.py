@@ -182,7 +182,12 @@ def run(out="morphomap-demo", *, pairs=EXAMPLES, stream=None, plots=True) -> lis
             rows.append(Row(pair, method, "plain", q.qm1, q.qm2, q.qm, q.crossings, int((~field.valid).sum()),
                             len(field), time.perf_counter() - tick))
             if method == "best":
-                auto_used[f"{pair} (best)"] = next(c.name for c in field.candidates if c.status == "won")
+                winner = next(c.name for c in field.candidates if c.status == "won")
+                if winner == "per_piece":  # the pieces' winners, assembled
+                    pieces = [r.name for r in field.piece_candidates if r.status == "won"]
+                    counts = {n: pieces.count(n) for n in sorted(set(pieces))}
+                    winner += " (" + ", ".join(f"{n} on {k} piece{'s' if k > 1 else ''}" for n, k in counts.items()) + ")"
+                auto_used[f"{pair} (best)"] = winner
             write_field(folder / f"{method}.csv", field)
             written.append(folder / f"{method}.csv")
             if plots:
