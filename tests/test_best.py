@@ -60,12 +60,12 @@ def check_pieces(field, c1, c2, closed):
     if next(c.name for c in field.candidates if c.status == "won") != "per_piece":
         return
     split = _core.split_curves(c1, c2, closed, True, -1.0)
-    mine = np.asarray(_core.piece_labels(split, field.starts, True)[0])
+    mine = np.asarray(_core.piece_labels(split, field.starts, True)["piece"])
     for k, name in winners.items():
         # Every piece with points of C1 has vectors (the split points' own alone measure perfect).
         assert (mine == k).any() or len(split.pieces[k].source) == 2
         theirs = candidate_field(c1, c2, name, closed=closed)
-        labels = np.asarray(_core.piece_labels(split, theirs.starts, True)[0])
+        labels = np.asarray(_core.piece_labels(split, theirs.starts, True)["piece"])
         np.testing.assert_array_equal(field.ends[mine == k], theirs.ends[labels == k])
         np.testing.assert_array_equal(field.method[mine == k], theirs.method[labels == k])
 
@@ -263,7 +263,7 @@ def test_split_curves_is_the_split_map_curves_uses():
     # Every vertex of C1 is in exactly one piece, and is labelled with it.
     inner = np.vstack([piece.source[1:-1] for piece in split.pieces])
     assert len(inner) == len(c1) and len(np.unique(inner, axis=0)) == len(c1)
-    labels, _ = _core.piece_labels(split, np.vstack([piece.source for piece in split.pieces]), True)
+    labels = _core.piece_labels(split, np.vstack([piece.source for piece in split.pieces]), True)["piece"]
     expected = np.concatenate([[-1] + [k] * (len(piece.source) - 2) + [-1] for k, piece in enumerate(split.pieces)])
     np.testing.assert_array_equal(labels, expected)
     # Without split points the pair is one piece, and best makes no per-piece field.

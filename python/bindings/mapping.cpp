@@ -53,7 +53,7 @@ void bind_mapping(py::module_& m) {
           py::gil_scoped_release release;
           field = map_curves(c1, c2, options);
         }
-        return py::make_tuple(std::move(field.starts), std::move(field.ends), method_codes(field.methods));
+        return field_record(std::move(field));
       },
       py::arg("c1"), py::arg("c2"), py::arg("method"), py::arg("closed"), py::arg("n"),
       py::arg("reverse"), py::arg("transform"), py::arg("split"), py::arg("anchor"),
@@ -89,7 +89,7 @@ void bind_mapping(py::module_& m) {
           py::gil_scoped_release release;
           labels = piece_labels(split, points, on_c1);
         }
-        return py::make_tuple(py::cast(labels.piece), std::move(labels.along));
+        return py::dict(py::arg("piece") = py::cast(labels.piece), py::arg("along") = std::move(labels.along));
       },
       py::arg("split"), py::arg("points"), py::arg("on_c1"));
 
@@ -109,13 +109,12 @@ void bind_mapping(py::module_& m) {
         }
         py::list streamlines;
         for (Points2& line : solution.streamlines) streamlines.append(py::cast(std::move(line)));
-        py::dict seconds;
-        seconds["mesh"] = solution.mesh_seconds;
-        seconds["solve"] = solution.solve_seconds;
-        seconds["trace"] = solution.trace_seconds;
-        return py::make_tuple(std::move(solution.vertices), std::move(solution.triangles),
-                              std::move(solution.potential), std::move(solution.ends), streamlines,
-                              seconds);
+        py::dict seconds(py::arg("mesh") = solution.mesh_seconds, py::arg("solve") = solution.solve_seconds,
+                         py::arg("trace") = solution.trace_seconds);
+        return py::dict(py::arg("vertices") = std::move(solution.vertices),
+                        py::arg("triangles") = std::move(solution.triangles),
+                        py::arg("potential") = std::move(solution.potential), py::arg("ends") = std::move(solution.ends),
+                        py::arg("streamlines") = streamlines, py::arg("seconds") = seconds);
       },
       py::arg("source"), py::arg("target"), py::arg("closed"), py::arg("mesh_size"),
       py::arg("mesh_fraction"), py::arg("keep_streamlines"));

@@ -85,8 +85,7 @@ void bind_surfaces(py::module_& m) {
           py::gil_scoped_release release;
           field = map_surfaces(v1, f1, v2, f2, options);
         }
-        return py::make_tuple(std::move(field.starts), std::move(field.ends), method_codes(field.methods),
-                              std::move(field.faces));
+        return field_record(std::move(field));
       },
       py::arg("v1"), py::arg("f1"), py::arg("v2"), py::arg("f2"), py::arg("method"), py::arg("reverse"),
       py::arg("mesh_size"));

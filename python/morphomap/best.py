@@ -174,9 +174,9 @@ def _per_piece(results, split, c1, c2, closed):
     ran = [(field, c) for field, c in results if field is not None]
     labels = []
     for field, _ in ran:
-        start_piece, start_along = _core.piece_labels(split, field.starts, True)
-        end_piece, end_along = _core.piece_labels(split, field.ends, False)
-        labels.append((np.asarray(start_piece), start_along, np.asarray(end_piece), end_along,
+        at_start = _core.piece_labels(split, field.starts, True)
+        at_end = _core.piece_labels(split, field.ends, False)
+        labels.append((np.asarray(at_start["piece"]), at_start["along"], np.asarray(at_end["piece"]), at_end["along"],
                        np.isfinite(field.starts).all(axis=1), np.isfinite(field.ends).all(axis=1)))
     rows, chosen = [], []
     for p, piece in enumerate(split.pieces):

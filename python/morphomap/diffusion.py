@@ -51,8 +51,9 @@ def solve_diffusion(c1, c2, *, closed=True, mesh_size=None, mesh_fraction=0.02, 
     -------
     DiffusionSolution
     """
-    vertices, triangles, potential, ends, lines, seconds = _core.solve_diffusion(
+    found = _core.solve_diffusion(
         as_points(c1, "c1"), as_points(c2, "c2"), as_flag(closed, "closed"),
         as_length(mesh_size, "mesh_size", 0.0), as_length(mesh_fraction, "mesh_fraction", 0.02),
         as_flag(streamlines, "streamlines"))
-    return DiffusionSolution(vertices, triangles, potential, ends, list(lines), dict(seconds))
+    return DiffusionSolution(found["vertices"], found["triangles"], found["potential"], found["ends"],
+                             list(found["streamlines"]), dict(found["seconds"]))

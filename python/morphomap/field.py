@@ -85,9 +85,12 @@ class DisplacementField:
         self._piece_candidates = None
 
     @classmethod
-    def _from_core(cls, starts, ends, methods, faces=None, **source):
-        codes, names = methods  # the core's codes and its table of their names
-        return cls(starts, ends, np.asarray(names)[np.asarray(codes, dtype=np.int64)], faces, **source)
+    def _from_core(cls, record, **source):
+        """The field from the core's record: starts, ends, methods (codes and the core's table of their
+        names) and, in 3D, faces."""
+        methods = record["methods"]
+        names = np.asarray(methods["names"])[np.asarray(methods["codes"], dtype=np.int64)]
+        return cls(record["starts"], record["ends"], names, record.get("faces"), **source)
 
     @property
     def starts(self) -> np.ndarray:

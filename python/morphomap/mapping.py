@@ -150,10 +150,10 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
     if anchor is not None:
         anchor = as_point(anchor, "anchor")
     c1 = as_points(c1, "c1")
-    starts, ends, codes = _core.map_curves(
+    record = _core.map_curves(
         c1, as_points(c2, "c2"), method, closed, count,
         as_flag(reverse, "reverse"), as_flag(transform, "transform"), as_flag(split, "split"), anchor,
         _threshold(density_threshold), as_length(contact_tolerance, "contact_tolerance", -1.0, allow_zero=True),
         as_length(mesh_size, "mesh_size", 0.0), as_length(mesh_fraction, "mesh_fraction", 0.02),
         as_length(stretch_weight, "stretch_weight", _core.DEFAULT_STRETCH_WEIGHT, allow_zero=True))
-    return DisplacementField._from_core(starts, ends, codes, source=c1, closed=closed)
+    return DisplacementField._from_core(record, source=c1, closed=closed)

@@ -140,6 +140,5 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None, skip
         raise ValueError("skip_below/workers: only for method 'best'")
     v1, f1 = as_surface(s1, "s1")
     v2, f2 = as_surface(s2, "s2")
-    starts, ends, codes, faces = _core.map_surfaces(v1, f1, v2, f2, method, reverse,
-                                                    as_length(mesh_size, "mesh_size", 0.0))
-    return DisplacementField._from_core(starts, ends, codes, faces)
+    record = _core.map_surfaces(v1, f1, v2, f2, method, reverse, as_length(mesh_size, "mesh_size", 0.0))
+    return DisplacementField._from_core(record)
