@@ -19,8 +19,10 @@ py::tuple interior_tuple(Interior&& out) {
                         out.min_jacobian, out.boundary_distance);
 }
 
-ExtendOptions extend_options(const std::string& method, double poisson_ratio, int substeps, double mesh_size) {
+ExtendOptions extend_options(const std::string& method, double poisson_ratio, int substeps, bool untangle,
+                             double mesh_size) {
   ExtendOptions options;
+  options.untangle = untangle;
   options.method = method == "elastic" ? ExtensionMethod::elastic : ExtensionMethod::harmonic;
   options.poisson_ratio = poisson_ratio;
   options.substeps = substeps;
@@ -34,8 +36,9 @@ void bind_extend(py::module_& m) {
   m.def(
       "extend_field_2d",
       [](const Points2Ref& starts, const Points2Ref& ends, const Points2Ref& source, const Points2Ref& points,
-         const FacesRef& cells, const std::string& method, double poisson_ratio, int substeps, double mesh_size) {
-        const ExtendOptions options = extend_options(method, poisson_ratio, substeps, mesh_size);
+         const FacesRef& cells, const std::string& method, double poisson_ratio, int substeps, bool untangle,
+         double mesh_size) {
+        const ExtendOptions options = extend_options(method, poisson_ratio, substeps, untangle, mesh_size);
         InteriorField2 out;
         InterruptGuard interruptible;
         {
@@ -45,12 +48,14 @@ void bind_extend(py::module_& m) {
         return interior_tuple(std::move(out));
       },
       py::arg("starts"), py::arg("ends"), py::arg("source"), py::arg("points"), py::arg("cells"),
-      py::arg("method"), py::arg("poisson_ratio"), py::arg("substeps"), py::arg("mesh_size"));
+      py::arg("method"), py::arg("poisson_ratio"), py::arg("substeps"), py::arg("untangle"),
+      py::arg("mesh_size"));
   m.def(
       "extend_field_3d",
       [](const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, const Points3Ref& points,
-         const TetrahedraRef& cells, const std::string& method, double poisson_ratio, int substeps, double mesh_size) {
-        const ExtendOptions options = extend_options(method, poisson_ratio, substeps, mesh_size);
+         const TetrahedraRef& cells, const std::string& method, double poisson_ratio, int substeps, bool untangle,
+         double mesh_size) {
+        const ExtendOptions options = extend_options(method, poisson_ratio, substeps, untangle, mesh_size);
         InteriorField3 out;
         InterruptGuard interruptible;
         {
@@ -60,5 +65,6 @@ void bind_extend(py::module_& m) {
         return interior_tuple(std::move(out));
       },
       py::arg("starts"), py::arg("ends"), py::arg("faces"), py::arg("points"), py::arg("cells"),
-      py::arg("method"), py::arg("poisson_ratio"), py::arg("substeps"), py::arg("mesh_size"));
+      py::arg("method"), py::arg("poisson_ratio"), py::arg("substeps"), py::arg("untangle"),
+      py::arg("mesh_size"));
 }

@@ -7,7 +7,7 @@ import numbers
 import numpy as np
 
 from . import _core
-from ._validate import as_choice, as_count, as_length, as_points
+from ._validate import as_choice, as_count, as_flag, as_length, as_points
 from .field import DisplacementField
 
 EXTENSION_METHODS = ("harmonic", "elastic")
@@ -72,7 +72,7 @@ def _poisson_ratio(value) -> float:
 
 
 def extend_field(field, boundary=None, *, method="harmonic", mesh=None, mesh_size=None, poisson_ratio=0.3,
-                 substeps=1) -> InteriorField:
+                 substeps=1, untangle=False) -> InteriorField:
     """Extend a boundary displacement field to the domain the source boundary encloses.
 
     Parameters
@@ -108,6 +108,14 @@ def extend_field(field, boundary=None, *, method="harmonic", mesh=None, mesh_siz
         growth steps invert cells under a single solve; substeps let the interior follow (the
         kidney pair, diffusion field: 17 of 345,011 triangles inverted by one solve, none with 4
         substeps; bench/README.md). Cells that the boundary field itself folds stay inverted.
+    untangle : bool
+        After the solve(s), move the free (interior) corners of the cells still inverted, each to
+        the point that maximises the smallest area (volume) ratio of its cells (a small linear
+        program per node, in sweeps until none is inverted or nothing moves). Those few nodes'
+        displacement is then no longer the method's solution; cells with every corner on the
+        boundary, and cells that the boundary field itself folds, stay inverted (the lung-like
+        pair, diffusion field, default mesh: the one tetrahedron that substeps left inverted is
+        untangled; bench/README.md).
 
     Returns
     -------
@@ -117,7 +125,7 @@ def extend_field(field, boundary=None, *, method="harmonic", mesh=None, mesh_siz
         raise TypeError(f"field: expected a DisplacementField, got {type(field).__name__}")
     as_choice(method, "method", EXTENSION_METHODS)
     options = dict(method=method, poisson_ratio=_poisson_ratio(poisson_ratio),
-                   substeps=as_count(substeps, "substeps", 1))
+                   substeps=as_count(substeps, "substeps", 1), untangle=as_flag(untangle, "untangle"))
     if mesh is not None:
         if not (isinstance(mesh, (tuple, list)) and len(mesh) == 2):
             raise TypeError("mesh: expected a (points, cells) pair")
