@@ -211,7 +211,7 @@ void solve_motion(Interior& out, const std::vector<char>& fixed, const ExtendOpt
     moved += increment;
   }
   if (options.untangle) {
-    constexpr int kSweeps = 10;  // each sweep over the corners of the cells still inverted
+    constexpr int kSweeps = 30;  // each sweep over the corners of the cells still inverted
     const auto solved = moved;
     detail::untangle(out.points, moved, out.cells, fixed, kSweeps);
     // Only the nodes it moved (moved - points would round every other node's displacement).

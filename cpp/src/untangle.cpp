@@ -24,15 +24,31 @@ double measure(const Points& x, const Cells& cells, Index c) {
   return edges.determinant() / (D == 2 ? 2.0 : 6.0);
 }
 
-template <class Points, class Cells>
-double star_ratio(const Points& rest, const Points& moved, const Cells& cells, const std::vector<Index>& star) {
+// A star's cells turned over (or flattened) and the smallest ratio among them all.
+struct StarState {
+  Index inverted = 0;
   double smallest = std::numeric_limits<double>::infinity();
-  for (const Index c : star) smallest = std::min(smallest, measure(moved, cells, c) / measure(rest, cells, c));
-  return smallest;
+  // Better: fewer inverted cells, or as many and a larger smallest ratio.
+  bool better_than(const StarState& other) const {
+    return inverted < other.inverted || (inverted == other.inverted && smallest > other.smallest);
+  }
+};
+
+template <class Points, class Cells>
+StarState star_state(const Points& rest, const Points& moved, const Cells& cells, const std::vector<Index>& star) {
+  StarState state;
+  for (const Index c : star) {
+    const double ratio = measure(moved, cells, c) / measure(rest, cells, c);
+    state.inverted += !(ratio > 0);
+    state.smallest = std::min(state.smallest, ratio);
+  }
+  return state;
 }
 
 // Moves node v to the point of the box around it that maximises the smallest area (volume) ratio
-// of its cells; keeps it where it is unless that ratio grows. Returns whether it moved.
+// of its cells; keeps it where it is unless that leaves fewer of them inverted, or as many and a
+// larger smallest ratio (where a boundary fold keeps one cell inverted, the best smallest ratio
+// could turn others over). Returns whether it moved.
 template <class Points, class Cells>
 bool improve_node(const Points& rest, Points& moved, const Cells& cells, const std::vector<Index>& star, Index v) {
   constexpr int D = Points::ColsAtCompileTime;
@@ -66,10 +82,10 @@ bool improve_node(const Points& rest, Points& moved, const Cells& cells, const s
   lp.set_c(D, -1.0);  // maximise t
   const auto solution = CGAL::solve_linear_program(lp, CGAL::Gmpzf());
   if (!solution.is_optimal()) return false;
-  const double old_ratio = star_ratio(rest, moved, cells, star);
+  const StarState before = star_state(rest, moved, cells, star);
   auto value = solution.variable_values_begin();
   for (int a = 0; a < D; ++a, ++value) moved(v, a) = at(a) + CGAL::to_double(*value);
-  if (moved.row(v).allFinite() && star_ratio(rest, moved, cells, star) > old_ratio) return true;
+  if (moved.row(v).allFinite() && star_state(rest, moved, cells, star).better_than(before)) return true;
   moved.row(v) = at;
   return false;
 }
@@ -77,28 +93,41 @@ bool improve_node(const Points& rest, Points& moved, const Cells& cells, const s
 template <class Points, class Cells>
 Index untangle_mesh(const Points& rest, Points& moved, const Cells& cells, const std::vector<char>& fixed,
                     int sweeps) {
-  std::vector<std::vector<Index>> stars;  // the cells of each node, made when first needed
+  std::vector<std::vector<Index>> stars(rest.rows());  // the cells of each node
+  for (Index c = 0; c < cells.rows(); ++c) {
+    for (Index i = 0; i < cells.cols(); ++i) stars[cells(c, i)].push_back(c);
+  }
   Index moved_count = 0;
+  int ring = 0;  // how far beyond the inverted cells' corners the nodes to move reach
+  constexpr int kRings = 2;
   for (int sweep = 0; sweep < sweeps; ++sweep) {
     check_interrupt();
     std::set<Index> nodes;
     for (Index c = 0; c < cells.rows(); ++c) {
       if (measure(moved, cells, c) / measure(rest, cells, c) > 0) continue;
-      for (Index i = 0; i < cells.cols(); ++i) {
-        if (!fixed[cells(c, i)]) nodes.insert(cells(c, i));
-      }
+      for (Index i = 0; i < cells.cols(); ++i) nodes.insert(cells(c, i));
     }
     if (nodes.empty()) break;
-    if (stars.empty()) {
-      stars.resize(rest.rows());
-      for (Index c = 0; c < cells.rows(); ++c) {
-        for (Index i = 0; i < cells.cols(); ++i) stars[cells(c, i)].push_back(c);
+    // Where the corners alone cannot move apart (a cluster of inverted cells), their neighbours
+    // make room.
+    for (int r = 0; r < ring; ++r) {
+      std::set<Index> grown = nodes;
+      for (const Index v : nodes) {
+        for (const Index c : stars[v]) {
+          for (Index i = 0; i < cells.cols(); ++i) grown.insert(cells(c, i));
+        }
       }
+      nodes.swap(grown);
     }
     Index moved_now = 0;
-    for (const Index v : nodes) moved_now += improve_node(rest, moved, cells, stars[v], v);
-    if (moved_now == 0) break;
+    for (const Index v : nodes) {
+      if (!fixed[v]) moved_now += improve_node(rest, moved, cells, stars[v], v);
+    }
     moved_count += moved_now;
+    if (moved_now == 0) {
+      if (ring == kRings) break;
+      ++ring;
+    }
   }
   return moved_count;
 }

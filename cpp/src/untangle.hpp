@@ -10,7 +10,9 @@ namespace morphomap::detail {
 
 // rest: the mesh as given; moved: its nodes after the motion, updated in place; fixed: the nodes
 // that must not move (the boundary). Sweeps over the free corners of the cells still inverted
-// until none is or a sweep moves no node (at most `sweeps`); returns the nodes moved.
+// (and, once those are stuck, over their neighbours up to two rings out) until none is inverted
+// or nothing moves (at most `sweeps`); a move never leaves more cells inverted. Returns the
+// number of moves.
 Index untangle(const Points2& rest, Points2& moved, const Faces& cells, const std::vector<char>& fixed, int sweeps);
 Index untangle(const Points3& rest, Points3& moved, const Tetrahedra& cells, const std::vector<char>& fixed,
                int sweeps);

@@ -49,7 +49,7 @@ struct ExtendOptions {
 // The extension: the displacement at the mesh's boundary nodes (those on an edge of one triangle
 // or a face of one tetrahedron only) is the field there (displacement_at: 2D nodes are projected
 // onto the source curve C1, which must be closed; 3D nodes onto the field's start triangles), and
-// inside it solves the method's equations (P1 finite elements, sparse Cholesky in 2D, conjugate
+// inside it solves the method's equations (P1 finite elements, multifrontal sparse Cholesky in 2D, conjugate
 // gradients first in 3D). Either method extends an affine boundary map to the same affine map.
 // 2D, mesh_cells empty: the region C1 encloses is meshed with CGAL's constrained Delaunay mesher,
 // every point of C1 a node, edges at most mesh_size (<= 0: graded from C1's point spacing).
