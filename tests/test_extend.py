@@ -153,6 +153,30 @@ def test_substeps_undo_the_inversions_of_the_kidney_bud():
     assert np.abs(stepped.displacement[boundary] - field.at(once.points[boundary])).max() < 1e-12
 
 
+def test_untangle_moves_only_inner_corners_of_the_inverted_cells():
+    # The kidney bud's one-solve inversions, untangled instead of substepped: no cell stays
+    # inverted, and only free corners of cells that were inverted move (at most a handful).
+    field = mm.map_curves(*mm.load_example("kidney"), "diffusion")
+    once = mm.extend_field(field, mesh_size=0.02)
+    untangled = mm.extend_field(field, mesh=(once.points, once.cells), untangle=True)
+    assert once.inverted >= 1 and untangled.inverted == 0 and untangled.min_jacobian > 0
+    cells = once.cells
+    edges = np.sort(np.vstack([cells[:, [0, 1]], cells[:, [1, 2]], cells[:, [2, 0]]]), axis=1)
+    unique, counts = np.unique(edges, axis=0, return_counts=True)
+    boundary = np.unique(unique[counts == 1])
+    moved = np.flatnonzero((untangled.displacement != once.displacement).any(axis=1))
+
+    def areas(x):
+        d1, d2 = x[cells[:, 1]] - x[cells[:, 0]], x[cells[:, 2]] - x[cells[:, 0]]
+        return d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
+
+    turned = areas(once.points + once.displacement) / areas(once.points) <= 0
+    assert 1 <= len(moved) <= 10
+    assert np.isin(moved, cells[turned]).all() and not np.isin(moved, boundary).any()
+    with pytest.raises(TypeError, match="untangle: expected True or False"):
+        mm.extend_field(field, mesh=(once.points, once.cells), untangle=1)
+
+
 def test_inversions_are_counted():
     # A boundary map that turns part of the disc inside out (a half turn of one side).
     c1 = circle(100)

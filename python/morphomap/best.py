@@ -110,7 +110,8 @@ def _run(job):
                                f"failed: {reason}")
     defects = int(q.crossings if hasattr(q, "crossings") else q.folds)
     misses = int((~field.valid).sum())
-    status = "crossings" if defects else "misses" if misses else "admissible" if math.isfinite(q.qm) else "failed: QM is NaN"
+    status = ("crossings" if defects else "misses" if misses
+              else "admissible" if math.isfinite(q.qm) else "failed: QM is NaN")
     return field, Candidate(name, float(q.qm1), float(q.qm2), float(q.qm), defects, misses,
                             time.perf_counter() - begin, status)
 

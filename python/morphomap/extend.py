@@ -7,7 +7,7 @@ import numbers
 import numpy as np
 
 from . import _core
-from ._validate import as_choice, as_count, as_length, as_points
+from ._validate import as_choice, as_count, as_flag, as_length, as_points
 from .field import DisplacementField
 
 EXTENSION_METHODS = ("harmonic", "elastic")
@@ -72,7 +72,7 @@ def _poisson_ratio(value) -> float:
 
 
 def extend_field(field, boundary=None, *, method="harmonic", mesh=None, mesh_size=None, poisson_ratio=0.3,
-                 substeps=1) -> InteriorField:
+                 substeps=1, untangle=False) -> InteriorField:
     """Extend a boundary displacement field to the domain the source boundary encloses.
 
     Parameters
@@ -95,8 +95,8 @@ def extend_field(field, boundary=None, *, method="harmonic", mesh=None, mesh_siz
         point of C1 a node. 3D without a mesh: the region S1 (the field's start triangles, a
         closed surface) encloses is meshed with CGAL's Mesh_3, its surface nodes on S1's
         triangles, and a tetrahedron with four corners on S1 (which would move with the boundary
-        field alone) split to get a node inside, unless all six of its edges lie on S1; the mesher's random choices are fixed, so the same field
-        gives the same mesh.
+        field alone) split to get a node inside, unless all six of its edges lie on S1; the mesher's
+        random choices are fixed, so the same field gives the same mesh.
     mesh_size : float, optional
         Without a mesh, 2D: the largest edge (default: graded from C1's point spacing); 3D: the
         edge length of the tetrahedra and surface triangles (default: S1's mean edge).
@@ -108,6 +108,14 @@ def extend_field(field, boundary=None, *, method="harmonic", mesh=None, mesh_siz
         growth steps invert cells under a single solve; substeps let the interior follow (the
         kidney pair, diffusion field: 17 of 345,011 triangles inverted by one solve, none with 4
         substeps; bench/README.md). Cells that the boundary field itself folds stay inverted.
+    untangle : bool
+        After the solve(s), move the free (interior) corners of the cells still inverted, each to
+        the point that maximises the smallest area (volume) ratio of its cells (a small linear
+        program per node, in sweeps until none is inverted or nothing moves). Those few nodes'
+        displacement is then no longer the method's solution; cells with every corner on the
+        boundary, and cells that the boundary field itself folds, stay inverted (the lung-like
+        pair, diffusion field, default mesh: the one tetrahedron that substeps left inverted is
+        untangled; bench/README.md).
 
     Returns
     -------
@@ -117,7 +125,7 @@ def extend_field(field, boundary=None, *, method="harmonic", mesh=None, mesh_siz
         raise TypeError(f"field: expected a DisplacementField, got {type(field).__name__}")
     as_choice(method, "method", EXTENSION_METHODS)
     options = dict(method=method, poisson_ratio=_poisson_ratio(poisson_ratio),
-                   substeps=as_count(substeps, "substeps", 1))
+                   substeps=as_count(substeps, "substeps", 1), untangle=as_flag(untangle, "untangle"))
     if mesh is not None:
         if not (isinstance(mesh, (tuple, list)) and len(mesh) == 2):
             raise TypeError("mesh: expected a (points, cells) pair")
@@ -142,4 +150,4 @@ def extend_field(field, boundary=None, *, method="harmonic", mesh=None, mesh_siz
             points, cells = np.zeros((0, 2)), np.zeros((0, 3), dtype=np.int64)
         result = _core.extend_field_2d(field.starts, field.ends, as_points(source, "boundary", 2), points, cells,
                                        mesh_size=as_length(mesh_size, "mesh_size", 0.0), **options)
-    return InteriorField(*result)
+    return InteriorField(**result)

@@ -9,7 +9,6 @@ from dataclasses import dataclass, field as dataclass_field
 
 import numpy as np
 
-from .field import DisplacementField
 
 
 @dataclass
@@ -240,8 +239,8 @@ def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **op
         frame 0 apart. 2D: the distance is the arc length along the frame between the two points'
         closest points (the shorter way round), and the new points are equally spaced along that
         arc. 3D: every triangle edge longer than the limit is split at its middle, moved onto the
-        frame's surface (the two triangles sharing it become four), until no edge is longer. New points are followed from
-        then on (their rows of ``trajectories`` are NaN before; ``born`` gives their frame).
+        frame's surface (the two triangles sharing it become four), until no edge is longer. New
+        points are followed from then on (their rows of ``trajectories`` are NaN before; ``born`` gives their frame).
         ``None`` follows only the points of frame 0. Default 2.
     progress : bool, optional
         A progress bar (tqdm) on stderr; by default when stderr is a terminal.

@@ -36,6 +36,11 @@ struct ExtendOptions {
   // the steps before have moved it (1: one solve on the mesh as given). Large growth steps invert
   // cells under one solve; re-solving on the moving mesh lets the interior follow the boundary.
   int substeps = 1;
+  // After the solve(s), move the free corners of the cells still inverted, each to the point that
+  // maximises the smallest area (volume) ratio of its cells (a small linear program per node, in
+  // sweeps until none is inverted or nothing moves). Those nodes' displacement is then no longer
+  // the method's solution; cells with all corners on the boundary cannot be untangled this way.
+  bool untangle = false;
   // No mesh given: the largest edge of the mesh made (<= 0: graded from the boundary's spacing).
   double mesh_size = 0.0;
   int seed = 0;  // 3D without a mesh: of Mesh_3's random choices (the same seed, the same mesh)
@@ -44,7 +49,7 @@ struct ExtendOptions {
 // The extension: the displacement at the mesh's boundary nodes (those on an edge of one triangle
 // or a face of one tetrahedron only) is the field there (displacement_at: 2D nodes are projected
 // onto the source curve C1, which must be closed; 3D nodes onto the field's start triangles), and
-// inside it solves the method's equations (P1 finite elements, sparse Cholesky in 2D, conjugate
+// inside it solves the method's equations (P1 finite elements, multifrontal sparse Cholesky in 2D, conjugate
 // gradients first in 3D). Either method extends an affine boundary map to the same affine map.
 // 2D, mesh_cells empty: the region C1 encloses is meshed with CGAL's constrained Delaunay mesher,
 // every point of C1 a node, edges at most mesh_size (<= 0: graded from C1's point spacing).

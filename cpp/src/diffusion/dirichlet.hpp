@@ -6,6 +6,7 @@
 #include <morphomap/types.hpp>
 
 #include "common/interrupt_check.hpp"
+#include "diffusion/multifrontal.hpp"
 #include "diffusion/nested_dissection.hpp"
 
 #include <Eigen/IterativeLinearSolvers>
@@ -102,8 +103,9 @@ Eigen::MatrixXd solve_direct(Eigen::SparseMatrix<double> stiffness, const Eigen:
 // (E, K) vertex indices; local(e) returns element e's K x K stiffness matrix. With iterative,
 // conjugate gradients with an incomplete Cholesky preconditioner come first (less memory and
 // time for 3D meshes), to the relative residual `tolerance`, the sparse LDL^T factorisation
-// otherwise or as the fallback. With `positions` (a row per vertex), the factorisation takes the
-// unknowns in a nested-dissection order of them (nested_dissection.hpp) rather than Eigen's AMD.
+// otherwise or as the fallback. With `positions` (a row per vertex), the factorisation is the
+// multifrontal Cholesky along a nested dissection of them (multifrontal.hpp; dense blocks, all
+// cores) rather than Eigen's simplicial LDL^T in its AMD order.
 template <class Elements, class Local>
 Eigen::MatrixXd solve_dirichlet_values(Index vertex_count, const Elements& elements, const std::vector<char>& fixed,
                                        Eigen::MatrixXd values, Local local, bool iterative,
@@ -163,11 +165,16 @@ Eigen::MatrixXd solve_dirichlet_values(Index vertex_count, const Elements& eleme
     for (Index v = 0; v < vertex_count; ++v) {
       if (unknown[v] >= 0) free_positions.row(unknown[v]) = positions.row(v);
     }
-    const auto order = nested_dissection(stiffness, free_positions);
+    const Dissection dissection = nested_dissection(stiffness, free_positions);
+    const auto& order = dissection.permutation;
     // The lower triangle is all the factorisation reads.
     Eigen::SparseMatrix<double> ordered(free_count, free_count);
     ordered.selfadjointView<Eigen::Lower>() = stiffness.selfadjointView<Eigen::Lower>().twistedBy(order);
-    x = order.transpose() * solve_direct<Eigen::NaturalOrdering<int>>(std::move(ordered), order * rhs);
+    const MultifrontalCholesky cholesky(ordered, dissection.fronts);
+    if (!cholesky.ok()) {
+      throw GeometryError("the Laplace system is singular: a part of the region touches neither boundary");
+    }
+    x = order.transpose() * cholesky.solve(order * rhs);
   } else if (!solved) {
     x = solve_direct(std::move(stiffness), rhs);
   }

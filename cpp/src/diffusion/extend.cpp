@@ -5,6 +5,7 @@
 #include "common/validation.hpp"
 #include "diffusion/dirichlet.hpp"
 #include "diffusion/region_mesh.hpp"
+#include "diffusion/untangle.hpp"
 #include "diffusion/volume_mesh.hpp"
 
 #include <algorithm>
@@ -185,7 +186,8 @@ Eigen::MatrixXd extension_step(const Points& x, const Cells& cells, const std::v
 
 // The motion of the interior: out.displacement holds the boundary displacement at the fixed
 // nodes on entry, the displacement of every node on return. In substeps, each moving the
-// boundary by an equal share of what remains and solving on the mesh as moved so far.
+// boundary by an equal share of what remains and solving on the mesh as moved so far; then, if
+// asked, the free corners of the cells still inverted moved to untangle them.
 template <int D, class Interior>
 void solve_motion(Interior& out, const std::vector<char>& fixed, const ExtendOptions& options) {
   // A flat cell has no gradients: its stiffness would be infinite.
@@ -207,6 +209,15 @@ void solve_motion(Interior& out, const std::vector<char>& fixed, const ExtendOpt
     }
     total += increment;
     moved += increment;
+  }
+  if (options.untangle) {
+    constexpr int kSweeps = 30;  // each sweep over the corners of the cells still inverted
+    const auto solved = moved;
+    detail::untangle(out.points, moved, out.cells, fixed, kSweeps);
+    // Only the nodes it moved (moved - points would round every other node's displacement).
+    for (Index v = 0; v < moved.rows(); ++v) {
+      if (moved.row(v) != solved.row(v)) total.row(v) = moved.row(v) - out.points.row(v);
+    }
   }
   out.displacement = total;
   measure_inversions(out);

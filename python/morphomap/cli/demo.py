@@ -186,7 +186,8 @@ def run(out="morphomap-demo", *, pairs=EXAMPLES, stream=None, plots=True) -> lis
                 if winner == "per_piece":  # the pieces' winners, assembled
                     pieces = [r.name for r in field.piece_candidates if r.status == "won"]
                     counts = {n: pieces.count(n) for n in sorted(set(pieces))}
-                    winner += " (" + ", ".join(f"{n} on {k} piece{'s' if k > 1 else ''}" for n, k in counts.items()) + ")"
+                    won = ", ".join(f"{n} on {k} piece{'s' if k > 1 else ''}" for n, k in counts.items())
+                    winner += f" ({won})"
                 auto_used[f"{pair} (best)"] = winner
             write_field(folder / f"{method}.csv", field)
             written.append(folder / f"{method}.csv")

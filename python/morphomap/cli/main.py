@@ -122,7 +122,8 @@ def _extend(args, parser) -> int:
         mesh = (solver_mesh.points[:, : field.dim], solver_mesh.cells_dict[kind])
     try:
         interior = morphomap.extend_field(field, mesh=mesh, mesh_size=args.extend_mesh_size, method=args.extension,
-                                          poisson_ratio=args.poisson_ratio, substeps=args.substeps)
+                                          poisson_ratio=args.poisson_ratio, substeps=args.substeps,
+                                          untangle=args.untangle)
     except (ValueError, TypeError, morphomap.InvalidInput, morphomap.GeometryError) as error:
         parser.error(f"cannot extend the field into {args.mesh or 'the domain'}: {error}")
     try:
@@ -325,47 +326,21 @@ def main(argv=None) -> int:
         "file meshio reads) or on a mesh made by CGAL. Writes the interior displacement.",
     )
     extend.add_argument("--mesh", metavar="MESH", help="the solver's mesh of the domain (.xdmf, .vtu, .msh, ...)")
-    extend.add_argument(
-        "--extend-mesh-size",
-        type=lambda text: _length(text, positive=True),
-        default=None,
-        metavar="H",
-        help="without --mesh: the largest edge of the mesh made (default: graded in 2D, S1's mean edge in 3D)",
-    )
-    extend.add_argument(
-        "--extension",
-        choices=("harmonic", "elastic"),
-        default="harmonic",
-        help="the interior problem: a vector Laplace equation or linear elasticity",
-    )
-    extend.add_argument(
-        "--poisson-ratio",
-        type=float,
-        default=0.3,
-        metavar="NU",
-        help="--extension elastic: the Poisson ratio, 0 <= NU < 0.5 (default 0.3)",
-    )
-    extend.add_argument(
-        "--substeps",
-        type=int,
-        default=1,
-        metavar="K",
-        help="move the mesh in K steps, each solved on the moved mesh (fewer inverted cells)",
-    )
-    extend.add_argument(
-        "--dt",
-        type=lambda text: _length(text, positive=True),
-        default=None,
-        metavar="DT",
-        help="the time between the frames: also write the velocity",
-    )
-    extend.add_argument(
-        "-o",
-        "--output",
-        required=True,
-        metavar="U.xdmf",
-        help="where to write the interior displacement (.xdmf, .vtu or a COMSOL .txt)",
-    )
+    extend.add_argument("--extend-mesh-size", type=lambda text: _length(text, positive=True), default=None,
+                        metavar="H", help="without --mesh: the largest edge of the mesh made (default: graded in 2D, "
+                                          "S1's mean edge in 3D)")
+    extend.add_argument("--extension", choices=("harmonic", "elastic"), default="harmonic",
+                        help="the interior problem: a vector Laplace equation or linear elasticity")
+    extend.add_argument("--poisson-ratio", type=float, default=0.3, metavar="NU",
+                        help="--extension elastic: the Poisson ratio, 0 <= NU < 0.5 (default 0.3)")
+    extend.add_argument("--substeps", type=int, default=1, metavar="K",
+                        help="move the mesh in K steps, each solved on the moved mesh (fewer inverted cells)")
+    extend.add_argument("--untangle", action="store_true",
+                        help="then move the inner corners of the cells still inverted to untangle them")
+    extend.add_argument("--dt", type=lambda text: _length(text, positive=True), default=None, metavar="DT",
+                        help="the time between the frames: also write the velocity")
+    extend.add_argument("-o", "--output", required=True, metavar="U.xdmf",
+                        help="where to write the interior displacement (.xdmf, .vtu or a COMSOL .txt)")
     extend.set_defaults(run=lambda args: _extend(args, extend))
     series = commands.add_parser(
         "series",
