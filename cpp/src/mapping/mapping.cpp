@@ -24,6 +24,7 @@
 #include <cmath>
 #include <complex>
 #include <limits>
+#include <memory>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -78,7 +79,16 @@ struct Job {
   bool shared_begin = false, shared_end = false;
   double anchor = 0.0;           // uniform: target arc position where fraction 0 lands
   int direction = 1;             // uniform: +1 forward along the target, -1 backward
+  // The query indexes of source and target, built on first use and shared by every attempt on
+  // the job (Algorithm 1 may try four) and by its reverse.
+  mutable std::shared_ptr<const CurveIndex> source_index, target_index;
 };
+
+const CurveIndex& target_index(const Job& job) {
+  if (!job.target_index) job.target_index = std::make_shared<const CurveIndex>(job.target, job.target_closed);
+  return *job.target_index;
+}
+
 
 // Vectors with the arc position of their start along the whole source curve, to order them.
 struct Vectors {
@@ -113,11 +123,11 @@ bool all_rows_equal(const Points2& points) {
 // order of their start points, are put back in order along the target, the set of ends kept.
 // Positions are unrolled step by step (the shorter way between neighbours on a closed curve), so
 // only local swaps move.
-void put_in_order(Points2& ends, const ArcCurve& target) {
+void put_in_order(Points2& ends, const ArcCurve& target, const CurveIndex& target_index) {
   const std::vector<Index> rows = detail::finite_rows(ends);
   if (rows.size() < 2) return;
   const Points2 found = ends(rows, Eigen::all);
-  const Vector arcs = CurveIndex(target.points(), target.closed()).closest_points(found).arc_lengths;
+  const Vector arcs = target_index.closest_points(found).arc_lengths;
   const double length = target.length();
   std::vector<double> unrolled(rows.size(), 0.0);
   for (std::size_t k = 1; k < rows.size(); ++k) {
@@ -221,9 +231,9 @@ Points2 basic_ends(MapMethod method, const Job& job, const Points2& starts, cons
   const ArcCurve target(job.target, job.target_closed, "c2");
   switch (method) {
     case MapMethod::minimal_distance:
-      return CurveIndex(job.target, job.target_closed).closest_points(starts).points;
+      return target_index(job).closest_points(starts).points;
     case MapMethod::normal:
-      return CurveIndex(job.target, job.target_closed).line_intersections(starts, job.normals).points;
+      return target_index(job).line_intersections(starts, job.normals).points;
     case MapMethod::uniform: {
       Points2 ends(starts.rows(), 2);
       for (Index i = 0; i < ends.rows(); ++i) {
@@ -236,7 +246,7 @@ Points2 basic_ends(MapMethod method, const Job& job, const Points2& starts, cons
       const DiffusionSolution solution = solve_diffusion(job.source, job.target, job.source_closed, settings.diffusion);
       Points2 ends(starts.rows(), 2);
       for (std::size_t j = 0; j < job.start_rows.size(); ++j) ends.row(j) = solution.ends.row(job.start_rows[j]);
-      put_in_order(ends, target);
+      put_in_order(ends, target, target_index(job));
       return ends;
     }
     case MapMethod::optimal:
@@ -262,7 +272,7 @@ Method basic_method(MapMethod method) {
 // Start points per gap: the mean distance from the starts to the target over their mean spacing
 // along the source.
 double point_density(const Job& job, const Points2& starts) {
-  const double gap = CurveIndex(job.target, job.target_closed).closest_points(starts).distances.mean();
+  const double gap = target_index(job).closest_points(starts).distances.mean();
   const double spacing = ArcCurve(job.source, job.source_closed, "c1").length() / starts.rows();
   return spacing > 0.0 ? gap / spacing : 0.0;
 }
@@ -279,12 +289,15 @@ Vectors forward(MapMethod method, const Job& job, const std::vector<double>& sta
 
 // A basic algorithm run backwards on one job (the paper's reverse mapping): from the target's
 // points (but shared crossings) to the source, flipped.
-Vectors reverse(MapMethod method, const Job& job, const ArcCurve& whole_source, const Settings& settings) {
+Vectors reverse(MapMethod method, const Job& job, const ArcCurve& whole_source, const CurveIndex& whole_source_index,
+                const Settings& settings) {
   Job back;
   back.source = job.target;
   back.source_closed = job.target_closed;
   back.target = job.source;
   back.target_closed = job.source_closed;
+  back.source_index = job.target_index;
+  back.target_index = job.source_index;
   const Index n = job.target.rows();
   for (Index i = 0; i < n; ++i) {
     const bool shared =
@@ -296,12 +309,13 @@ Vectors reverse(MapMethod method, const Job& job, const ArcCurve& whole_source, 
   v.ends = start_points(back);
   if (method == MapMethod::normal) back.normals = normals(back.source, back.source_closed)(back.start_rows, Eigen::all);
   v.starts = basic_ends(method, back, v.ends, settings);
+  job.source_index = back.target_index, job.target_index = back.source_index;  // for the next attempt
   v.methods.assign(v.starts.rows(), reversed(basic_method(method)));
   v.keys.assign(v.starts.rows(), std::numeric_limits<double>::infinity());
   const std::vector<Index> found = detail::finite_rows(v.starts);
   if (!found.empty()) {
     const Points2 located = v.starts(found, Eigen::all);
-    const Vector arcs = CurveIndex(whole_source.points(), whole_source.closed()).closest_points(located).arc_lengths;
+    const Vector arcs = whole_source_index.closest_points(located).arc_lengths;
     for (std::size_t j = 0; j < found.size(); ++j) v.keys[found[j]] = whole_source.wrap(arcs[j]);
   }
   // A miss keeps its point on the target (ends), so that it can be found; its start is NaN.
@@ -321,18 +335,18 @@ bool complete(const Vectors& v) { return v.starts.allFinite() && v.ends.allFinit
 // forward diffusion, which is crossing-free too; then the first attempt if it missed nothing
 // (crossings and all); then minimal distance, which always finds a point.
 Vectors run(MapMethod method, const Job& job, const std::vector<double>& start_keys,
-            const ArcCurve& whole_source, const Settings& settings) {
+            const ArcCurve& whole_source, const CurveIndex& whole_source_index, const Settings& settings) {
   detail::check_interrupt();
   if (method != MapMethod::automatic) return forward(method, job, start_keys, settings);
   if (job.start_rows.empty()) return forward(MapMethod::normal, job, start_keys, settings);
   const Vectors first = settings.density_threshold > 0.0 &&
                                 point_density(job, start_points(job)) > settings.density_threshold
-                            ? reverse(MapMethod::minimal_distance, job, whole_source, settings)
+                            ? reverse(MapMethod::minimal_distance, job, whole_source, whole_source_index, settings)
                             : forward(MapMethod::normal, job, start_keys, settings);
   if (complete(first) && count_crossings(first.starts, first.ends) == 0) return first;
   for (const bool backwards : {true, false}) {
     try {
-      Vectors v = backwards ? reverse(MapMethod::diffusion, job, whole_source, settings)
+      Vectors v = backwards ? reverse(MapMethod::diffusion, job, whole_source, whole_source_index, settings)
                             : forward(MapMethod::diffusion, job, start_keys, settings);
       // (A reverse mapping from a target piece without points of its own between the two
       // meetings has no vectors at all: that leaves the piece of C1 unmapped, not complete.)
@@ -528,6 +542,8 @@ Vectors map_directed(const Points2& source_points, const Points2& target_points,
                      const Settings& settings) {
   const ArcCurve source(source_points, closed, "c1");
   const ArcCurve target(target_points, closed, "c2");
+  const auto whole_source_index = std::make_shared<const CurveIndex>(source.points(), closed);
+  const auto whole_target_index = std::make_shared<const CurveIndex>(target.points(), closed);
   const Index n = source.size();
   const bool wants_normals = method == MapMethod::normal || method == MapMethod::automatic;
   const Points2 source_normals = wants_normals ? normals(source.points(), closed) : Points2();
@@ -557,6 +573,8 @@ Vectors map_directed(const Points2& source_points, const Points2& target_points,
     add_starts(job, all, 0);
     job.target = target.points();
     job.target_closed = closed;
+    job.source_index = whole_source_index;
+    job.target_index = whole_target_index;
     if (method == MapMethod::uniform) {
       double from = 0.0;  // source anchor
       if (!closed) {
@@ -574,7 +592,7 @@ Vectors map_directed(const Points2& source_points, const Points2& target_points,
       job.fractions.resize(n);
       for (Index i = 0; i < n; ++i) job.fractions[i] = source.forward(from, source.arc(i)) / source.length();
     }
-    std::vector<Vectors> parts{run(method, job, keys, source, settings)};
+    std::vector<Vectors> parts{run(method, job, keys, source, *whole_source_index, settings)};
     return gather(parts);
   }
 
@@ -597,7 +615,7 @@ Vectors map_directed(const Points2& source_points, const Points2& target_points,
   }
   if (!stretch_rows.empty()) {
     const Points2 queries = source.points()(stretch_rows, Eigen::all);
-    const Points2 closest = CurveIndex(target.points(), closed).closest_points(queries).points;
+    const Points2 closest = whole_target_index->closest_points(queries).points;
     for (std::size_t j = 0; j < stretch_rows.size(); ++j) {
       fixed_starts.push_back(queries.row(j).transpose()), fixed_ends.push_back(closest.row(j).transpose());
       fixed.keys.push_back(source.arc(stretch_rows[j])), fixed_methods.push_back(Method::minimal_distance);
@@ -628,7 +646,7 @@ Vectors map_directed(const Points2& source_points, const Points2& target_points,
     }
     std::vector<double> keys(m.size());
     for (std::size_t j = 0; j < m.size(); ++j) keys[j] = source.arc(m[j]);
-    parts.push_back(run(method, job, keys, source, settings));
+    parts.push_back(run(method, job, keys, source, *whole_source_index, settings));
   }
   return gather(parts);
 }
