@@ -46,8 +46,7 @@ void bind_curves(py::module_& m) {
   m.def("signed_area", &signed_area, py::arg("points"), Release());
   m.def("orientation", &orientation, py::arg("points"), Release());
   m.def("normals", &normals, py::arg("points"), py::arg("closed"), Release());
-  m.def("is_self_intersecting", &is_self_intersecting, py::arg("points"), py::arg("closed"),
-        Release());
+  m.def("is_self_intersecting", &is_self_intersecting, py::arg("points"), py::arg("closed"), Release());
 
   py::class_<CurveIndex>(m, "CurveIndex")
       .def(py::init<const Points2Ref&, bool>(), py::arg("curve"), py::arg("closed"), Release())
@@ -85,8 +84,8 @@ void bind_curves(py::module_& m) {
           found = curve_intersections(c1, c2, closed);
         }
         return py::dict("points"_a = std::move(found.points), "arc_lengths1"_a = std::move(found.arc_lengths1),
-                        "arc_lengths2"_a = std::move(found.arc_lengths2),
-                        "segments1"_a = std::move(found.segments1), "segments2"_a = std::move(found.segments2));
+                        "arc_lengths2"_a = std::move(found.arc_lengths2), "segments1"_a = std::move(found.segments1),
+                        "segments2"_a = std::move(found.segments2));
       },
       py::arg("c1"), py::arg("c2"), py::arg("closed"));
 

@@ -55,9 +55,8 @@ void bind_extend(py::module_& m) {
         }
         return interior_record(std::move(out));
       },
-      py::arg("starts"), py::arg("ends"), py::arg("source"), py::arg("points"), py::arg("cells"),
-      py::arg("method"), py::arg("poisson_ratio"), py::arg("substeps"), py::arg("untangle"),
-      py::arg("mesh_size"));
+      py::arg("starts"), py::arg("ends"), py::arg("source"), py::arg("points"), py::arg("cells"), py::arg("method"),
+      py::arg("poisson_ratio"), py::arg("substeps"), py::arg("untangle"), py::arg("mesh_size"));
   m.def(
       "extend_field_3d",
       [](const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, const Points3Ref& points,
@@ -72,7 +71,6 @@ void bind_extend(py::module_& m) {
         }
         return interior_record(std::move(out));
       },
-      py::arg("starts"), py::arg("ends"), py::arg("faces"), py::arg("points"), py::arg("cells"),
-      py::arg("method"), py::arg("poisson_ratio"), py::arg("substeps"), py::arg("untangle"),
-      py::arg("mesh_size"));
+      py::arg("starts"), py::arg("ends"), py::arg("faces"), py::arg("points"), py::arg("cells"), py::arg("method"),
+      py::arg("poisson_ratio"), py::arg("substeps"), py::arg("untangle"), py::arg("mesh_size"));
 }

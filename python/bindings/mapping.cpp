@@ -23,7 +23,8 @@ MapMethod map_method(const std::string& name) {
   if (name == "uniform") return MapMethod::uniform;
   if (name == "auto") return MapMethod::automatic;
   if (name == "optimal") return MapMethod::optimal;
-  throw InvalidInput("method: expected 'auto', 'minimal_distance', 'normal', 'diffusion', 'uniform' or 'optimal', got '" + name + "'");
+  throw InvalidInput(
+      "method: expected 'auto', 'minimal_distance', 'normal', 'diffusion', 'uniform' or 'optimal', got '" + name + "'");
 }
 
 }  // namespace
@@ -31,9 +32,9 @@ MapMethod map_method(const std::string& name) {
 void bind_mapping(py::module_& m) {
   m.def(
       "map_curves",
-      [](const Points2Ref& c1, const Points2Ref& c2, const std::string& method, bool closed, Index n,
-         bool reverse, bool transform, bool split, std::optional<Vec2> anchor, double density_threshold,
-         double contact_tolerance, double mesh_size, double mesh_fraction, double stretch_weight) {
+      [](const Points2Ref& c1, const Points2Ref& c2, const std::string& method, bool closed, Index n, bool reverse,
+         bool transform, bool split, std::optional<Vec2> anchor, double density_threshold, double contact_tolerance,
+         double mesh_size, double mesh_fraction, double stretch_weight) {
         CurveMappingOptions options;
         options.method = map_method(method);
         options.closed = closed;
@@ -55,10 +56,10 @@ void bind_mapping(py::module_& m) {
         }
         return field_record(std::move(field));
       },
-      py::arg("c1"), py::arg("c2"), py::arg("method"), py::arg("closed"), py::arg("n"),
-      py::arg("reverse"), py::arg("transform"), py::arg("split"), py::arg("anchor"),
-      py::arg("density_threshold"), py::arg("contact_tolerance"), py::arg("mesh_size"),
-      py::arg("mesh_fraction"), py::arg("stretch_weight") = kDefaultStretchWeight);
+      py::arg("c1"), py::arg("c2"), py::arg("method"), py::arg("closed"), py::arg("n"), py::arg("reverse"),
+      py::arg("transform"), py::arg("split"), py::arg("anchor"), py::arg("density_threshold"),
+      py::arg("contact_tolerance"), py::arg("mesh_size"), py::arg("mesh_fraction"),
+      py::arg("stretch_weight") = kDefaultStretchWeight);
   m.attr("DEFAULT_STRETCH_WEIGHT") = kDefaultStretchWeight;
 
   py::class_<CurvePiece>(m, "CurvePiece")
@@ -95,8 +96,8 @@ void bind_mapping(py::module_& m) {
 
   m.def(
       "solve_diffusion",
-      [](const Points2Ref& source, const Points2Ref& target, bool closed, double mesh_size,
-         double mesh_fraction, bool keep_streamlines) {
+      [](const Points2Ref& source, const Points2Ref& target, bool closed, double mesh_size, double mesh_fraction,
+         bool keep_streamlines) {
         DiffusionOptions options;
         options.mesh_size = mesh_size;
         options.mesh_fraction = mesh_fraction;
@@ -111,11 +112,11 @@ void bind_mapping(py::module_& m) {
         for (Points2& line : solution.streamlines) streamlines.append(py::cast(std::move(line)));
         py::dict seconds(py::arg("mesh") = solution.mesh_seconds, py::arg("solve") = solution.solve_seconds,
                          py::arg("trace") = solution.trace_seconds);
-        return py::dict(py::arg("vertices") = std::move(solution.vertices),
-                        py::arg("triangles") = std::move(solution.triangles),
-                        py::arg("potential") = std::move(solution.potential), py::arg("ends") = std::move(solution.ends),
-                        py::arg("streamlines") = streamlines, py::arg("seconds") = seconds);
+        return py::dict(
+            py::arg("vertices") = std::move(solution.vertices), py::arg("triangles") = std::move(solution.triangles),
+            py::arg("potential") = std::move(solution.potential), py::arg("ends") = std::move(solution.ends),
+            py::arg("streamlines") = streamlines, py::arg("seconds") = seconds);
       },
-      py::arg("source"), py::arg("target"), py::arg("closed"), py::arg("mesh_size"),
-      py::arg("mesh_fraction"), py::arg("keep_streamlines"));
+      py::arg("source"), py::arg("target"), py::arg("closed"), py::arg("mesh_size"), py::arg("mesh_fraction"),
+      py::arg("keep_streamlines"));
 }

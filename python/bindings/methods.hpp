@@ -12,7 +12,8 @@
 inline pybind11::dict method_codes(const std::vector<morphomap::Method>& methods) {
   pybind11::array_t<std::int8_t> codes(static_cast<pybind11::ssize_t>(methods.size()));
   auto out = codes.mutable_unchecked<1>();
-  for (std::size_t i = 0; i < methods.size(); ++i) out(static_cast<pybind11::ssize_t>(i)) = static_cast<std::int8_t>(methods[i]);
+  for (std::size_t i = 0; i < methods.size(); ++i)
+    out(static_cast<pybind11::ssize_t>(i)) = static_cast<std::int8_t>(methods[i]);
   pybind11::list names;
   for (int code = 0; code < morphomap::kMethodCount; ++code) {
     names.append(morphomap::method_name(static_cast<morphomap::Method>(code)));
@@ -21,12 +22,13 @@ inline pybind11::dict method_codes(const std::vector<morphomap::Method>& methods
 }
 
 inline pybind11::dict field_record(morphomap::DisplacementField2&& field) {
-  return pybind11::dict(pybind11::arg("starts") = std::move(field.starts), pybind11::arg("ends") = std::move(field.ends),
+  return pybind11::dict(pybind11::arg("starts") = std::move(field.starts),
+                        pybind11::arg("ends") = std::move(field.ends),
                         pybind11::arg("methods") = method_codes(field.methods));
 }
 
 inline pybind11::dict field_record(morphomap::DisplacementField3&& field) {
-  return pybind11::dict(pybind11::arg("starts") = std::move(field.starts), pybind11::arg("ends") = std::move(field.ends),
-                        pybind11::arg("methods") = method_codes(field.methods),
-                        pybind11::arg("faces") = std::move(field.faces));
+  return pybind11::dict(
+      pybind11::arg("starts") = std::move(field.starts), pybind11::arg("ends") = std::move(field.ends),
+      pybind11::arg("methods") = method_codes(field.methods), pybind11::arg("faces") = std::move(field.faces));
 }

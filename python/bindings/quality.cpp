@@ -13,8 +13,7 @@ using namespace morphomap;
 void bind_quality(py::module_& m) {
   m.def(
       "curve_quality",
-      [](const Points2Ref& starts, const Points2Ref& ends, const Points2Ref& c1,
-         const Points2Ref& c2, bool closed) {
+      [](const Points2Ref& starts, const Points2Ref& ends, const Points2Ref& c1, const Points2Ref& c2, bool closed) {
         CurveQuality q;
         InterruptGuard interruptible;
         {

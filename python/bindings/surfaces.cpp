@@ -73,8 +73,8 @@ void bind_surfaces(py::module_& m) {
 
   m.def(
       "map_surfaces",
-      [](const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2,
-         const std::string& method, bool reverse, double mesh_size) {
+      [](const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2, const std::string& method,
+         bool reverse, double mesh_size) {
         SurfaceMappingOptions options;
         options.method = surface_method(method);
         options.reverse = reverse;
@@ -103,16 +103,14 @@ void bind_surfaces(py::module_& m) {
         }
         return py::dict("qm1"_a = q.qm1, "qm2"_a = q.qm2, "qm"_a = q.qm, "folds"_a = q.folds);
       },
-      py::arg("starts"), py::arg("ends"), py::arg("faces"), py::arg("v1"), py::arg("f1"), py::arg("v2"),
-      py::arg("f2"));
+      py::arg("starts"), py::arg("ends"), py::arg("faces"), py::arg("v1"), py::arg("f1"), py::arg("v2"), py::arg("f2"));
   m.def(
       "count_folds",
       [](const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, const Points3Ref& v1,
-         const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2) {
-        return count_folds(starts, ends, faces, v1, f1, v2, f2);
-      },
-      py::arg("starts"), py::arg("ends"), py::arg("faces"), py::arg("v1"), py::arg("f1"), py::arg("v2"),
-      py::arg("f2"), Release());
+         const FacesRef& f1, const Points3Ref& v2,
+         const FacesRef& f2) { return count_folds(starts, ends, faces, v1, f1, v2, f2); },
+      py::arg("starts"), py::arg("ends"), py::arg("faces"), py::arg("v1"), py::arg("f1"), py::arg("v2"), py::arg("f2"),
+      Release());
 
   m.def(
       "remesh_surface",

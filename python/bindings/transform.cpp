@@ -9,8 +9,7 @@ using namespace pybind11::literals;  // results cross as dicts keyed by field na
 using namespace morphomap;
 
 void bind_transform(py::module_& m) {
-  m.def("overlap_area", &overlap_area, py::arg("a"), py::arg("b"),
-        py::call_guard<py::gil_scoped_release>());
+  m.def("overlap_area", &overlap_area, py::arg("a"), py::arg("b"), py::call_guard<py::gil_scoped_release>());
 
   m.def(
       "align_curves",

@@ -12,36 +12,36 @@ inline int& failures() {
 }
 }  // namespace morphomap_test
 
-#define CHECK(cond)                                                              \
-  do {                                                                           \
-    if (!(cond)) {                                                               \
+#define CHECK(cond)                                                                 \
+  do {                                                                              \
+    if (!(cond)) {                                                                  \
       std::fprintf(stderr, "%s:%d: CHECK(%s) failed\n", __FILE__, __LINE__, #cond); \
-      ++morphomap_test::failures();                                              \
-    }                                                                            \
+      ++morphomap_test::failures();                                                 \
+    }                                                                               \
   } while (0)
 
-#define CHECK_NEAR(a, b, tol)                                                             \
-  do {                                                                                    \
-    const double va_ = (a), vb_ = (b);                                                    \
-    if (!(std::abs(va_ - vb_) <= (tol))) {                                                \
-      std::fprintf(stderr, "%s:%d: |%s - %s| = |%.17g - %.17g| > %g\n", __FILE__, __LINE__, \
-                   #a, #b, va_, vb_, static_cast<double>(tol));                           \
-      ++morphomap_test::failures();                                                       \
-    }                                                                                     \
+#define CHECK_NEAR(a, b, tol)                                                                                 \
+  do {                                                                                                        \
+    const double va_ = (a), vb_ = (b);                                                                        \
+    if (!(std::abs(va_ - vb_) <= (tol))) {                                                                    \
+      std::fprintf(stderr, "%s:%d: |%s - %s| = |%.17g - %.17g| > %g\n", __FILE__, __LINE__, #a, #b, va_, vb_, \
+                   static_cast<double>(tol));                                                                 \
+      ++morphomap_test::failures();                                                                           \
+    }                                                                                                         \
   } while (0)
 
-#define CHECK_THROWS(expr, type)                                                        \
-  do {                                                                                  \
-    bool thrown_ = false;                                                               \
-    try {                                                                               \
-      (void)(expr);                                                                     \
-    } catch (const type&) {                                                             \
-      thrown_ = true;                                                                   \
-    }                                                                                   \
-    if (!thrown_) {                                                                     \
+#define CHECK_THROWS(expr, type)                                                              \
+  do {                                                                                        \
+    bool thrown_ = false;                                                                     \
+    try {                                                                                     \
+      (void)(expr);                                                                           \
+    } catch (const type&) {                                                                   \
+      thrown_ = true;                                                                         \
+    }                                                                                         \
+    if (!thrown_) {                                                                           \
       std::fprintf(stderr, "%s:%d: %s did not throw %s\n", __FILE__, __LINE__, #expr, #type); \
-      ++morphomap_test::failures();                                                     \
-    }                                                                                   \
+      ++morphomap_test::failures();                                                           \
+    }                                                                                         \
   } while (0)
 
 #define TEST_MAIN_END() return morphomap_test::failures() == 0 ? EXIT_SUCCESS : EXIT_FAILURE

@@ -49,19 +49,19 @@ bool crosses(Segment s, Segment t) {
 }
 
 void test_pairs() {
-  CHECK(crosses({{0, 0}, {2, 2}}, {{0, 2}, {2, 0}}));      // an X
-  CHECK(!crosses({{0, 0}, {1, 0}}, {{0, 1}, {1, 1}}));     // parallel
-  CHECK(!crosses({{0, 0}, {1, 0}}, {{0, 0}, {0, 1}}));     // shared start
-  CHECK(!crosses({{0, 0}, {1, 0}}, {{2, 1}, {1, 0}}));     // end of one is start of the other
-  CHECK(crosses({{0, 0}, {2, 0}}, {{1, 0}, {1, 1}}));      // T-junction
+  CHECK(crosses({{0, 0}, {2, 2}}, {{0, 2}, {2, 0}}));   // an X
+  CHECK(!crosses({{0, 0}, {1, 0}}, {{0, 1}, {1, 1}}));  // parallel
+  CHECK(!crosses({{0, 0}, {1, 0}}, {{0, 0}, {0, 1}}));  // shared start
+  CHECK(!crosses({{0, 0}, {1, 0}}, {{2, 1}, {1, 0}}));  // end of one is start of the other
+  CHECK(crosses({{0, 0}, {2, 0}}, {{1, 0}, {1, 1}}));   // T-junction
   CHECK(crosses({{0, 0}, {2, 0}}, {{1, -1}, {1, 0}}));
-  CHECK(!crosses({{0, 0}, {1, 0}}, {{1, 0}, {2, 0}}));     // collinear, end to end
-  CHECK(!crosses({{0, 0}, {1, 0}}, {{2, 0}, {3, 0}}));     // collinear, apart
-  CHECK(crosses({{0, 0}, {2, 0}}, {{1, 0}, {3, 0}}));      // collinear, overlapping
-  CHECK(crosses({{0, 0}, {2, 0}}, {{0, 0}, {1, 0}}));      // shared start, overlapping
-  CHECK(crosses({{0, 0}, {1, 1}}, {{0, 0}, {1, 1}}));      // identical
-  CHECK(crosses({{0, 0}, {3, 0}}, {{1, 0}, {2, 0}}));      // one inside the other
-  CHECK(!crosses({{0, 0}, {2, 0}}, {{0, 0}, {-1, 0}}));    // shared start, opposite ways
+  CHECK(!crosses({{0, 0}, {1, 0}}, {{1, 0}, {2, 0}}));   // collinear, end to end
+  CHECK(!crosses({{0, 0}, {1, 0}}, {{2, 0}, {3, 0}}));   // collinear, apart
+  CHECK(crosses({{0, 0}, {2, 0}}, {{1, 0}, {3, 0}}));    // collinear, overlapping
+  CHECK(crosses({{0, 0}, {2, 0}}, {{0, 0}, {1, 0}}));    // shared start, overlapping
+  CHECK(crosses({{0, 0}, {1, 1}}, {{0, 0}, {1, 1}}));    // identical
+  CHECK(crosses({{0, 0}, {3, 0}}, {{1, 0}, {2, 0}}));    // one inside the other
+  CHECK(!crosses({{0, 0}, {2, 0}}, {{0, 0}, {-1, 0}}));  // shared start, opposite ways
   // Zero-length segments: a point inside a segment crosses it, a point at an end does not.
   CHECK(crosses({{1, 1}, {1, 1}}, {{0, 0}, {2, 2}}));
   CHECK(!crosses({{0, 0}, {0, 0}}, {{0, 0}, {2, 2}}));
@@ -75,11 +75,8 @@ void test_pairs() {
 
   // Several at once: pairs are (i, j), i < j, in order; NaN rows are skipped.
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  const std::vector<Pair> p = pairs_of({{{0, 0}, {2, 2}},
-                                        {{nan, 0}, {2, 0}},
-                                        {{0, 2}, {2, 0}},
-                                        {{5, 5}, {6, 6}},
-                                        {{1, 0}, {1, 3}}});
+  const std::vector<Pair> p =
+      pairs_of({{{0, 0}, {2, 2}}, {{nan, 0}, {2, 0}}, {{0, 2}, {2, 0}}, {{5, 5}, {6, 6}}, {{1, 0}, {1, 3}}});
   CHECK((p == std::vector<Pair>{{0, 2}, {0, 4}, {2, 4}}));
 }
 

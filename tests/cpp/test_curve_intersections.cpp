@@ -14,8 +14,8 @@
 #include <utility>
 #include <vector>
 
-using morphomap::CurveIntersections;
 using morphomap::curve_intersections;
+using morphomap::CurveIntersections;
 using morphomap::Index;
 using morphomap::InvalidInput;
 using morphomap::Points2;
@@ -59,8 +59,7 @@ double ellipse_error(const CurveIntersections& r) {
   if (r.points.rows() != 4) return 1;
   double err = 0;
   for (Index i = 0; i < 4; ++i) {
-    err = std::max({err, std::abs(r.points(i, 0) - expected[i][0]),
-                    std::abs(r.points(i, 1) - expected[i][1])});
+    err = std::max({err, std::abs(r.points(i, 0) - expected[i][0]), std::abs(r.points(i, 1) - expected[i][1])});
   }
   return err;
 }
@@ -89,9 +88,10 @@ void test_ellipses() {
   const double bound = 2 * (2 * sigma / (15.0 / 17.0));
   const double err_generic = ellipse_error(generic);
   CHECK(err_generic < bound);
-  std::printf("ellipse crossings, %lld points each: error %.3g with vertices on the crossings, "
-              "%.3g generic (bound %.3g)\n",
-              static_cast<long long>(n), err_on, err_generic, bound);
+  std::printf(
+      "ellipse crossings, %lld points each: error %.3g with vertices on the crossings, "
+      "%.3g generic (bound %.3g)\n",
+      static_cast<long long>(n), err_on, err_generic, bound);
 
   // Arc lengths: the point at arc length s1 along c1 is the crossing point.
   for (Index i = 0; i < generic.points.rows(); ++i) {
@@ -184,16 +184,16 @@ void test_overlaps() {
     Index count;
   };
   const Case cases[] = {
-      {rect(1, 0.25, 2, 0.75), 0},    // beside, on the right
-      {rect(-1, 0.25, 0, 0.75), 2},   // beside, on the left: shifted into the square
-      {rect(0, 0.25, 0.5, 0.75), 0},  // nested on the left edge: shifted inwards
-      {rect(0.5, 0.25, 1, 0.75), 2},  // nested on the right edge: shifted out
-      {rect(0.25, 1, 0.75, 2), 0},    // beside, on top: shifted along the edge and up
-      {rect(0.25, 0, 0.75, 0.5), 0},  // nested on the bottom edge
-      {rect(0.25, -1, 0.75, 0), 2},   // beside, below: shifted up into the square
-      {rect(1, 0, 2, 1), 0},          // a whole edge shared
-      {rect(0.5, 0, 1.5, 1), 2},      // overlapping halves: two proper crossings
-      {square, 2},                    // identical: the shifted copy crosses at two corners
+      {rect(1, 0.25, 2, 0.75), 0},                 // beside, on the right
+      {rect(-1, 0.25, 0, 0.75), 2},                // beside, on the left: shifted into the square
+      {rect(0, 0.25, 0.5, 0.75), 0},               // nested on the left edge: shifted inwards
+      {rect(0.5, 0.25, 1, 0.75), 2},               // nested on the right edge: shifted out
+      {rect(0.25, 1, 0.75, 2), 0},                 // beside, on top: shifted along the edge and up
+      {rect(0.25, 0, 0.75, 0.5), 0},               // nested on the bottom edge
+      {rect(0.25, -1, 0.75, 0), 2},                // beside, below: shifted up into the square
+      {rect(1, 0, 2, 1), 0},                       // a whole edge shared
+      {rect(0.5, 0, 1.5, 1), 2},                   // overlapping halves: two proper crossings
+      {square, 2},                                 // identical: the shifted copy crosses at two corners
       {pts({{0, 0}, {0, 1}, {1, 1}, {1, 0}}), 2},  // identical, the other way round
   };
   for (const Case& c : cases) {

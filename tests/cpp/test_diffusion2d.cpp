@@ -45,7 +45,8 @@ void concentric_circles() {
   CHECK(solution.potential.minCoeff() >= -1e-12 && solution.potential.maxCoeff() <= 1 + 1e-12);
   // Streamlines are radial: the end of point i is 2 c1_i, to 2e-3 of the gap (1).
   double end_error = 0.0;
-  for (Index i = 0; i < c1.rows(); ++i) end_error = std::max(end_error, (solution.ends.row(i) - 2.0 * c1.row(i)).norm());
+  for (Index i = 0; i < c1.rows(); ++i)
+    end_error = std::max(end_error, (solution.ends.row(i) - 2.0 * c1.row(i)).norm());
   CHECK(end_error < 2e-3);
 }
 

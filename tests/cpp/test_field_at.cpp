@@ -8,9 +8,9 @@
 
 #include <cmath>
 
+using morphomap::displacement_at;
 using morphomap::DisplacementField2;
 using morphomap::DisplacementField3;
-using morphomap::displacement_at;
 using morphomap::Index;
 using morphomap::InvalidInput;
 using morphomap::Points2;
@@ -54,7 +54,8 @@ void test_surfaces() {
   DisplacementField3 field{s.vertices, s.vertices * a.transpose(), s.faces, {}};
   Points3 centroids(s.faces.rows(), 3);
   for (Index f = 0; f < s.faces.rows(); ++f) {
-    centroids.row(f) = (s.vertices.row(s.faces(f, 0)) + s.vertices.row(s.faces(f, 1)) + s.vertices.row(s.faces(f, 2))) / 3;
+    centroids.row(f) =
+        (s.vertices.row(s.faces(f, 0)) + s.vertices.row(s.faces(f, 1)) + s.vertices.row(s.faces(f, 2))) / 3;
   }
   const auto at = displacement_at(field, centroids);
   const Points3 expected = centroids * a.transpose() - centroids;

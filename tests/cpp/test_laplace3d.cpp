@@ -51,8 +51,8 @@ void concentric_spheres() {
   CHECK(solution.ends.allFinite());
   const double rms = radial_rms(inner.vertices, solution.ends, 4.0);
   std::printf("spheres 1 -> 4: %lld tetrahedra, RMS end error %.2e, %.2f s mesh, %.2f s solve, %.2f s trace\n",
-              static_cast<long long>(solution.tetrahedra.rows()), rms, solution.seconds.mesh,
-              solution.seconds.solve, solution.seconds.trace);
+              static_cast<long long>(solution.tetrahedra.rows()), rms, solution.seconds.mesh, solution.seconds.solve,
+              solution.seconds.trace);
   CHECK(rms < 0.03);  // level-3 spheres; tests/test_diffusion3d.py holds level 4 to 0.01
   // The ends lie on the target, a polyhedron inscribed in the sphere of radius 4.
   for (Index i = 0; i < solution.ends.rows(); ++i) {
@@ -77,7 +77,9 @@ void concentric_spheres() {
   for (Index t = 0; t < solution.tetrahedra.rows(); ++t) {
     Eigen::Matrix3d e;
     for (int i = 0; i < 3; ++i) {
-      e.col(i) = (solution.vertices.row(solution.tetrahedra(t, i + 1)) - solution.vertices.row(solution.tetrahedra(t, 0))).transpose();
+      e.col(i) =
+          (solution.vertices.row(solution.tetrahedra(t, i + 1)) - solution.vertices.row(solution.tetrahedra(t, 0)))
+              .transpose();
     }
     CHECK(e.determinant() > 0.0);
     volume += e.determinant() / 6.0;

@@ -16,8 +16,8 @@ using morphomap::CurveMappingOptions;
 using morphomap::DisplacementField2;
 using morphomap::Index;
 using morphomap::InvalidInput;
-using morphomap::MapMethod;
 using morphomap::map_curves;
+using morphomap::MapMethod;
 using morphomap::Method;
 using morphomap::Points2;
 using morphomap_test::pi;
@@ -138,7 +138,8 @@ void automatic_maps_concentric_circles_radially() {
   const DisplacementField2 field = map(c1, c2, MapMethod::automatic);
   CHECK(all_are(field, Method::normal));
   CHECK(morphomap::count_crossings(field.starts, field.ends) == 0);
-  for (Index i = 0; i < field.size(); ++i) CHECK_NEAR(field.ends.row(i).norm(), 1.5, 1.5 * (1 - std::cos(pi / 2000)) + 1e-12);
+  for (Index i = 0; i < field.size(); ++i)
+    CHECK_NEAR(field.ends.row(i).norm(), 1.5, 1.5 * (1 - std::cos(pi / 2000)) + 1e-12);
 }
 
 void bad_curves_are_named() {

@@ -10,8 +10,8 @@
 #include <csignal>
 #include <string>
 
-using morphomap::detail::ShellMesh;
 using morphomap::detail::mesh_in_child;
+using morphomap::detail::ShellMesh;
 
 namespace {
 
@@ -56,10 +56,12 @@ void exceptions_come_back() {
 void a_crash_is_an_error() {
   for (const int sig : {SIGSEGV, SIGFPE, SIGABRT}) {
     try {
-      mesh_in_child([sig]() -> ShellMesh {
-        std::raise(sig);
-        return {};
-      }, "meshing the test region");
+      mesh_in_child(
+          [sig]() -> ShellMesh {
+            std::raise(sig);
+            return {};
+          },
+          "meshing the test region");
       CHECK(false);
     } catch (const morphomap::detail::MesherCrashed& e) {
       const std::string message = e.what();

@@ -85,11 +85,11 @@ void check_against_simplicial(const Problem& p, unsigned seed) {
 }  // namespace
 
 int main() {
-  check_against_simplicial(grid(90, 70, 1, 1e-3, false, 1), 11);  // 2D, many levels
+  check_against_simplicial(grid(90, 70, 1, 1e-3, false, 1), 11);   // 2D, many levels
   check_against_simplicial(grid(16, 13, 11, 1e-3, false, 2), 12);  // 3D
-  check_against_simplicial(grid(60, 40, 1, 1e-3, true, 3), 13);   // two blocks: an empty separator
-  check_against_simplicial(grid(7, 5, 1, 1e-3, false, 4), 14);    // one leaf
-  check_against_simplicial(grid(3000, 1, 1, 1e-3, false, 5), 15); // a path: one-node separators
+  check_against_simplicial(grid(60, 40, 1, 1e-3, true, 3), 13);    // two blocks: an empty separator
+  check_against_simplicial(grid(7, 5, 1, 1e-3, false, 4), 14);     // one leaf
+  check_against_simplicial(grid(3000, 1, 1, 1e-3, false, 5), 15);  // a path: one-node separators
   // An indefinite matrix (a negative shift below the smallest eigenvalue) has no Cholesky factor.
   Eigen::MatrixXd x;
   CHECK(!solve(grid(40, 30, 1, -1.0, false, 6), Eigen::MatrixXd::Ones(1200, 1), x));

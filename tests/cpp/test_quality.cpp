@@ -65,8 +65,8 @@ void squares() {
   // areas are 0.25, 0.3125 and 0.4375.
   const auto q = quality(field(starts, rows({{0.5, -1}, {2, 0.5}, {-0.25, 2}})), c1, c2);
   CHECK_NEAR(q.qm1, 0.0, 1e-15);
-  const double qm2 = (std::pow(2.0 / (8.0 / 3) - 1, 2) + std::pow(2.5 / (8.0 / 3) - 1, 2) +
-                      std::pow(3.5 / (8.0 / 3) - 1, 2)) / 3;
+  const double qm2 =
+      (std::pow(2.0 / (8.0 / 3) - 1, 2) + std::pow(2.5 / (8.0 / 3) - 1, 2) + std::pow(3.5 / (8.0 / 3) - 1, 2)) / 3;
   CHECK_NEAR(q.qm2, qm2, 1e-15);
   CHECK(q.crossings == 0);
 

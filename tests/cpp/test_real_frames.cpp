@@ -193,10 +193,13 @@ void debris_inward_and_unused_vertices_are_named() {
   morphomap_test::Surface unused = organ;
   unused.vertices.conservativeResize(unused.vertices.rows() + 1, 3);
   unused.vertices.row(unused.vertices.rows() - 1) << 50, 50, 50;
-  for (const MapMethod method : {MapMethod::automatic, MapMethod::minimal_distance, MapMethod::normal,
-                                 MapMethod::diffusion}) {
-    CHECK(surface_message(both, outer, method).rfind("s1: the surface has 2 separate components (1280, 80 faces)", 0) == 0);
-    CHECK(surface_message(outer, morphomap_test::flipped(organ), method).rfind("s2: the faces are oriented inwards", 0) == 0);
+  for (const MapMethod method :
+       {MapMethod::automatic, MapMethod::minimal_distance, MapMethod::normal, MapMethod::diffusion}) {
+    CHECK(surface_message(both, outer, method).rfind("s1: the surface has 2 separate components (1280, 80 faces)", 0) ==
+          0);
+    CHECK(
+        surface_message(outer, morphomap_test::flipped(organ), method).rfind("s2: the faces are oriented inwards", 0) ==
+        0);
     CHECK(surface_message(unused, outer, method).rfind("s1: vertex 642", 0) == 0);
   }
 }

@@ -13,14 +13,13 @@
 using morphomap::Index;
 using morphomap::InvalidInput;
 using morphomap::Points2;
-using morphomap::ResampleMethod;
 using morphomap::resample;
+using morphomap::ResampleMethod;
 
 namespace {
 
 const double pi = std::acos(-1.0);
-const ResampleMethod methods[] = {ResampleMethod::linear, ResampleMethod::spline,
-                                  ResampleMethod::pchip};
+const ResampleMethod methods[] = {ResampleMethod::linear, ResampleMethod::spline, ResampleMethod::pchip};
 
 Points2 regular_polygon(Index m, double radius = 1.0) {
   Points2 p(m, 2);
@@ -31,9 +30,7 @@ Points2 regular_polygon(Index m, double radius = 1.0) {
   return p;
 }
 
-double dist(const Points2& p, Index i, const Points2& q, Index j) {
-  return (p.row(i) - q.row(j)).norm();
-}
+double dist(const Points2& p, Index i, const Points2& q, Index j) { return (p.row(i) - q.row(j)).norm(); }
 
 // The message of the InvalidInput that f throws, or "" when it throws none.
 template <class F>
@@ -46,9 +43,7 @@ std::string invalid_message(F f) {
   return "";
 }
 
-bool starts_with(const std::string& s, const std::string& prefix) {
-  return s.compare(0, prefix.size(), prefix) == 0;
-}
+bool starts_with(const std::string& s, const std::string& prefix) { return s.compare(0, prefix.size(), prefix) == 0; }
 
 void test_invalid_input() {
   const Points2 tri = regular_polygon(3);
@@ -73,8 +68,7 @@ void test_invalid_input() {
     CHECK(starts_with(invalid_message([&] { resample(same, 10, true, m); }), "points: "));
     CHECK(starts_with(invalid_message([&] { resample(two, 10, true, m); }), "points: "));
     CHECK(starts_with(invalid_message([&] { resample(two_repeated, 10, true, m); }), "points: "));
-    CHECK(starts_with(invalid_message([&] { resample(Points2(0, 2), 10, false, m); }),
-                      "points: "));
+    CHECK(starts_with(invalid_message([&] { resample(Points2(0, 2), 10, false, m); }), "points: "));
     CHECK(starts_with(invalid_message([&] { resample(two, 1, false, m); }), "n: "));
     CHECK(starts_with(invalid_message([&] { resample(two, 0, false, m); }), "n: "));
     CHECK(starts_with(invalid_message([&] { resample(two, -5, false, m); }), "n: "));
@@ -85,8 +79,7 @@ void test_invalid_input() {
   // Coordinates so large that the length overflows.
   Points2 huge(3, 2);
   huge << -1e308, 0, 1e308, 0, 0, 1e308;
-  CHECK(starts_with(invalid_message([&] { resample(huge, 10, true, ResampleMethod::linear); }),
-                    "points: "));
+  CHECK(starts_with(invalid_message([&] { resample(huge, 10, true, ResampleMethod::linear); }), "points: "));
   // The smallest valid requests work.
   CHECK(resample(two, 2, false).rows() == 2);
   CHECK(resample(tri, 3, true).rows() == 3);

@@ -78,7 +78,7 @@ double brute_line(const Mesh& m, const Eigen::Vector3d& o, const Eigen::Vector3d
 }  // namespace
 
 int main() {
-  const Mesh sphere = unit_sphere(4);   // 2048 faces
+  const Mesh sphere = unit_sphere(4);  // 2048 faces
   const Mesh ellipsoid = scaled(unit_sphere(5), 2.0, 1.5, 1.2);
 
   // Checks of a closed surface.
@@ -151,7 +151,8 @@ int main() {
   // Mapping the sphere onto the ellipsoid.
   SurfaceMappingOptions options;
   options.method = MapMethod::normal;
-  const DisplacementField3 normal = map_surfaces(sphere.vertices, sphere.faces, ellipsoid.vertices, ellipsoid.faces, options);
+  const DisplacementField3 normal =
+      map_surfaces(sphere.vertices, sphere.faces, ellipsoid.vertices, ellipsoid.faces, options);
   CHECK(normal.size() == sphere.vertices.rows());
   CHECK(normal.faces == sphere.faces);
   for (Index i = 0; i < normal.size(); ++i) CHECK(normal.valid(i));
@@ -162,7 +163,8 @@ int main() {
   CHECK(std::isfinite(qn.qm1) && std::isfinite(qn.qm2) && qn.qm1 < 0.5);
 
   options.method = MapMethod::minimal_distance;
-  const DisplacementField3 md = map_surfaces(sphere.vertices, sphere.faces, ellipsoid.vertices, ellipsoid.faces, options);
+  const DisplacementField3 md =
+      map_surfaces(sphere.vertices, sphere.faces, ellipsoid.vertices, ellipsoid.faces, options);
   const SurfaceQuality qmd = quality(md, sphere.vertices, sphere.faces, ellipsoid.vertices, ellipsoid.faces);
   CHECK(qmd.qm1 > qn.qm1);
 
@@ -176,7 +178,8 @@ int main() {
   // Reverse: starts on the sphere, ends at the ellipsoid's vertices, in the ellipsoid's order.
   options.method = MapMethod::normal;
   options.reverse = true;
-  const DisplacementField3 back = map_surfaces(sphere.vertices, sphere.faces, ellipsoid.vertices, ellipsoid.faces, options);
+  const DisplacementField3 back =
+      map_surfaces(sphere.vertices, sphere.faces, ellipsoid.vertices, ellipsoid.faces, options);
   CHECK(back.size() == ellipsoid.vertices.rows());
   CHECK(back.faces == ellipsoid.faces);
   CHECK((back.ends - ellipsoid.vertices).cwiseAbs().maxCoeff() == 0.0);
@@ -222,11 +225,13 @@ int main() {
                       sphere.faces) == upper - 4);
     Faces out = sphere.faces;
     out(0, 0) = sphere.vertices.rows();
-    CHECK_THROWS(count_folds(sphere.vertices, folded, out, sphere.vertices, sphere.faces, sphere.vertices,
-                             sphere.faces), InvalidInput);
+    CHECK_THROWS(
+        count_folds(sphere.vertices, folded, out, sphere.vertices, sphere.faces, sphere.vertices, sphere.faces),
+        InvalidInput);
     const Faces open = sphere.faces.topRows(sphere.faces.rows() - 1);
-    CHECK_THROWS(count_folds(sphere.vertices, folded, sphere.faces, sphere.vertices, sphere.faces, sphere.vertices,
-                             open), InvalidInput);
+    CHECK_THROWS(
+        count_folds(sphere.vertices, folded, sphere.faces, sphere.vertices, sphere.faces, sphere.vertices, open),
+        InvalidInput);
   }
 
   options.method = MapMethod::uniform;

@@ -157,8 +157,8 @@ void test_all_vertices_cross() {
   check_area(unit, dents, 0.7, 1e-15);
   CHECK_NEAR(clipped_area(dents, unit), 0.7, 1e-15);
   // Dents that also cross the edges inside them.
-  const Points2 deep = pts({{0, 0}, {0.5, 0.3}, {0.8, -0.3}, {1, 0}, {1.3, 0.5}, {1, 1}, {0.5, 0.7},
-                           {0.2, 1.3}, {0, 1}, {-0.3, 0.5}});
+  const Points2 deep =
+      pts({{0, 0}, {0.5, 0.3}, {0.8, -0.3}, {1, 0}, {1.3, 0.5}, {1, 1}, {0.5, 0.7}, {0.2, 1.3}, {0, 1}, {-0.3, 0.5}});
   check_area(unit, deep, clipped_area(deep, unit), 1e-15);
 }
 
@@ -223,9 +223,7 @@ void test_timing() {
   }
 }
 
-double max_distance(const Points2& a, const Points2& b) {
-  return (a - b).rowwise().norm().maxCoeff();
-}
+double max_distance(const Points2& a, const Points2& b) { return (a - b).rowwise().norm().maxCoeff(); }
 
 void test_similarity() {
   Similarity2 t;
@@ -262,9 +260,10 @@ void test_align_closed() {
     const Similarity2 found = align_curves(c1, target);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const double error = max_distance(found.apply(c1), c2) / size2;
-    std::printf("align_curves (1000 points, 23.7 degrees, 1.3x, shift 0.2 size): error %.2e of the "
-                "size, scale %.8f, angle %.6f degrees, %.2f s\n",
-                error, found.scale, found.angle * 180 / pi, seconds);
+    std::printf(
+        "align_curves (1000 points, 23.7 degrees, 1.3x, shift 0.2 size): error %.2e of the "
+        "size, scale %.8f, angle %.6f degrees, %.2f s\n",
+        error, found.scale, found.angle * 180 / pi, seconds);
     CHECK(error < 1e-3);
     CHECK_NEAR(found.scale, 1.3, 1e-12);
   }

@@ -8,11 +8,11 @@ namespace morphomap {
 
 // One answer per query; rows of a query that found nothing are NaN (segments: -1).
 struct CurveHits {
-  Points2 points;       // the point found on the curve
-  Vector distances;     // closest points: Euclidean distance; lines: signed distance along the
-                        // unit direction from the origin to the point
-  IndexVector segments; // segment i runs from point i to point i+1 (wrapping on a closed curve)
-  Vector arc_lengths;   // arc-length parameter of the point, measured from the first point
+  Points2 points;        // the point found on the curve
+  Vector distances;      // closest points: Euclidean distance; lines: signed distance along the
+                         // unit direction from the origin to the point
+  IndexVector segments;  // segment i runs from point i to point i+1 (wrapping on a closed curve)
+  Vector arc_lengths;    // arc-length parameter of the point, measured from the first point
 };
 
 // A polyline with a bounding-volume hierarchy over its segments, built once and queried many
@@ -40,8 +40,8 @@ class CurveIndex {
 };
 
 CurveHits closest_points(const Points2Ref& queries, const Points2Ref& curve, bool closed = true);
-CurveHits line_intersections(const Points2Ref& origins, const Points2Ref& directions,
-                             const Points2Ref& curve, bool closed = true);
+CurveHits line_intersections(const Points2Ref& origins, const Points2Ref& directions, const Points2Ref& curve,
+                             bool closed = true);
 
 // The points where c2 crosses c1, in order along c1.
 struct CurveIntersections {
@@ -67,7 +67,6 @@ struct CurveIntersections {
 // is exactly that vertex. Ties in the order along c1 go by arc length on c2. Exact consecutive
 // repeats of points are ignored; segments1/segments2 index the given rows (segment i runs from
 // row i to the next). Both curves are closed unless closed is false.
-CurveIntersections curve_intersections(const Points2Ref& c1, const Points2Ref& c2,
-                                       bool closed = true);
+CurveIntersections curve_intersections(const Points2Ref& c1, const Points2Ref& c2, bool closed = true);
 
 }  // namespace morphomap

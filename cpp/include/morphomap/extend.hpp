@@ -8,11 +8,11 @@ namespace morphomap {
 
 struct InteriorField2 {
   Points2 points;
-  Faces cells;                    // triangles
-  Points2 displacement;           // at every point
-  Index inverted = 0;             // cells turned over (or flattened) by the motion x -> x + u
-  double min_jacobian = 0.0;      // smallest ratio of a cell's signed area after and before
-  double boundary_distance = 0.0; // farthest boundary node from the source curve (projected)
+  Faces cells;                     // triangles
+  Points2 displacement;            // at every point
+  Index inverted = 0;              // cells turned over (or flattened) by the motion x -> x + u
+  double min_jacobian = 0.0;       // smallest ratio of a cell's signed area after and before
+  double boundary_distance = 0.0;  // farthest boundary node from the source curve (projected)
 };
 
 struct InteriorField3 {

@@ -39,9 +39,7 @@ struct DisplacementField2 {
   std::vector<Method> methods;
 
   Index size() const { return starts.rows(); }
-  bool valid(Index i) const {
-    return starts.row(i).allFinite() && ends.row(i).allFinite();
-  }
+  bool valid(Index i) const { return starts.row(i).allFinite() && ends.row(i).allFinite(); }
 };
 
 // The same for surfaces: start points are the vertices of the source surface, and faces their
@@ -53,9 +51,7 @@ struct DisplacementField3 {
   std::vector<Method> methods;
 
   Index size() const { return starts.rows(); }
-  bool valid(Index i) const {
-    return starts.row(i).allFinite() && ends.row(i).allFinite();
-  }
+  bool valid(Index i) const { return starts.row(i).allFinite() && ends.row(i).allFinite(); }
 };
 
 }  // namespace morphomap

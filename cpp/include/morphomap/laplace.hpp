@@ -11,19 +11,19 @@ struct DiffusionOptions {
   // the lattice, a triangle next to a point the mesher added may reach the lattice triangles'
   // circumdiameter (1.12 times it). 0 picks mesh_fraction * the mean gap between the curves
   // (twice the region's area over its boundary length), but no finer than a lattice of
-  // max(40000, 20 * the number of curve points) vertices over the region would be. Near the curves the mesh is graded from
-  // their point spacing and refined where the gap is narrow, whatever this bound.
+  // max(40000, 20 * the number of curve points) vertices over the region would be. Near the curves the mesh is graded
+  // from their point spacing and refined where the gap is narrow, whatever this bound.
   double mesh_size = 0.0;
   double mesh_fraction = 0.02;
   bool keep_streamlines = false;
 };
 
 struct DiffusionSolution {
-  Points2 vertices;     // the region mesh: every point of both curves is a vertex
-  Faces triangles;  // counter-clockwise
-  Vector potential;     // c at the vertices: P1 finite elements, c = 1 on the source, 0 on the target
-  Points2 ends;         // for each source point, where its streamline of -grad c meets the target
-                        // (NaN if it does not)
+  Points2 vertices;                  // the region mesh: every point of both curves is a vertex
+  Faces triangles;                   // counter-clockwise
+  Vector potential;                  // c at the vertices: P1 finite elements, c = 1 on the source, 0 on the target
+  Points2 ends;                      // for each source point, where its streamline of -grad c meets the target
+                                     // (NaN if it does not)
   std::vector<Points2> streamlines;  // with keep_streamlines: one polyline per source point
   double mesh_seconds = 0.0, solve_seconds = 0.0, trace_seconds = 0.0;  // where the time went
 };
@@ -34,7 +34,7 @@ struct DiffusionSolution {
 // ~mesh_size inside the region, joined to the curves by CGAL's constrained Delaunay mesher. The P1
 // gradient is recovered at the vertices and interpolated linearly (a continuous flow whose
 // streamlines do not cross), and each streamline crosses the mesh triangle by triangle in RK4 steps.
-DiffusionSolution solve_diffusion(const Points2Ref& source, const Points2Ref& target,
-                                  bool closed = true, const DiffusionOptions& options = {});
+DiffusionSolution solve_diffusion(const Points2Ref& source, const Points2Ref& target, bool closed = true,
+                                  const DiffusionOptions& options = {});
 
 }  // namespace morphomap

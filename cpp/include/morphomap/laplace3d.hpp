@@ -23,11 +23,11 @@ struct ShellDiffusionTimings {
 };
 
 struct ShellDiffusionSolution {
-  Points3 vertices;        // the tetrahedral mesh of the region (Mesh_3: its boundary approximates
-  Tetrahedra tetrahedra;   // the surfaces; input vertices are not mesh vertices); positively oriented
-  Vector potential;        // c at the vertices: P1 finite elements, 1 on the source, 0 on the target
-  Points3 ends;            // for each source vertex, where its streamline of -grad c meets the
-                           // target surface (NaN if it does not)
+  Points3 vertices;                  // the tetrahedral mesh of the region (Mesh_3: its boundary approximates
+  Tetrahedra tetrahedra;             // the surfaces; input vertices are not mesh vertices); positively oriented
+  Vector potential;                  // c at the vertices: P1 finite elements, 1 on the source, 0 on the target
+  Points3 ends;                      // for each source vertex, where its streamline of -grad c meets the
+                                     // target surface (NaN if it does not)
   std::vector<Points3> streamlines;  // with keep_streamlines: the source vertex, the streamline
                                      // from the mesh boundary, and the end (NaN if lost)
   std::vector<char> touching;        // per source vertex: it touches the target (its end is its

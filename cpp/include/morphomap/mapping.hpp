@@ -14,19 +14,19 @@ enum class MapMethod { minimal_distance, normal, diffusion, uniform, automatic, 
 
 struct CurveMappingOptions {
   MapMethod method = MapMethod::automatic;  // the paper's Algorithm 1
-  bool closed = true;       // both curves closed, or both open
-  Index n = 0;              // 0: the given points of the source curve are the start points;
-                            // > 0: both curves are first resampled to n equally spaced points
-  bool reverse = false;     // map C2 -> C1 and flip the vectors
-  bool transform = false;   // Appendix A: align a scaled C1 with C2 first, then carry back
-  bool split = true;        // map each pair of segments between intersection points on its own
-  double density_threshold = 0.0;  // "auto": where the start points of a pair of segments are
-                                   // denser than this many per gap (mean distance to C2 over
-                                   // mean spacing), try reverse minimal distance before normal
-                                   // mapping (the paper's density rule); 0: off
-  std::optional<Vec2> anchor;  // uniform mapping of closed curves that do not cross: a point
-                               // of C1 (its nearest curve point) that maps onto its nearest
-                               // point of C2
+  bool closed = true;                       // both curves closed, or both open
+  Index n = 0;                              // 0: the given points of the source curve are the start points;
+                                            // > 0: both curves are first resampled to n equally spaced points
+  bool reverse = false;                     // map C2 -> C1 and flip the vectors
+  bool transform = false;                   // Appendix A: align a scaled C1 with C2 first, then carry back
+  bool split = true;                        // map each pair of segments between intersection points on its own
+  double density_threshold = 0.0;           // "auto": where the start points of a pair of segments are
+                                            // denser than this many per gap (mean distance to C2 over
+                                            // mean spacing), try reverse minimal distance before normal
+                                            // mapping (the paper's density rule); 0: off
+  std::optional<Vec2> anchor;               // uniform mapping of closed curves that do not cross: a point
+                                            // of C1 (its nearest curve point) that maps onto its nearest
+                                            // point of C2
   // Where the curves touch or run together closer than this (a stretch of source points within
   // it of the target, or a single touching point), they are split there as at a crossing, and
   // the points on the stretch map to their closest point of the target; whatever `split` says.
@@ -46,8 +46,7 @@ struct CurveMappingOptions {
 // found nothing keeps the point it came from: NaN ends on forward vectors, NaN starts on reverse
 // ones. With n > 0 the start and end points are put onto c1 and c2 as given (the resampled
 // curves cut their corners).
-DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2,
-                              const CurveMappingOptions& options = {});
+DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2, const CurveMappingOptions& options = {});
 
 // One subproblem of a pair: the stretch of C1 between two consecutive split points (crossings when
 // splitting, contact stretches always; or an end of open curves) and the stretch of C2 between

@@ -13,8 +13,8 @@ namespace morphomap {
 constexpr double kDefaultStretchWeight = 10.0;
 
 struct MonotoneMatch {
-  Vector arcs;      // arc position of each end along the target, strictly increasing
-  Points2 points;   // the end points on the target
+  Vector arcs;          // arc position of each end along the target, strictly increasing
+  Points2 points;       // the end points on the target
   double energy = 0.0;  // the minimised energy (below)
   Index samples = 0;    // M: the target was sampled at M + 1 equally spaced positions
 };
@@ -36,7 +36,8 @@ struct MonotoneMatch {
 // whose new vector crosses or touches (other than at a shared end) one of the three vectors before
 // it costs 1e6 more, so the path avoids crossings where it can: exactly for the neighbour, for the
 // two before that as the best path into the previous state has them (the state holds one vector;
-// staircase contours of masks cross two or three apart). Vectors further apart are not checked. Each step advances by 1 .. 8 M / (n + 1) + 2 samples.
+// staircase contours of masks cross two or three apart). Vectors further apart are not checked. Each step advances by 1
+// .. 8 M / (n + 1) + 2 samples.
 //
 // What is guaranteed, and what is not:
 // - By construction: the order. Ends strictly increase along the target (bijective at the
@@ -45,9 +46,9 @@ struct MonotoneMatch {
 //   path avoiding it costs 1e6 more (the penalty is added, not forbidden). Vectors four or more
 //   apart are not checked. A sufficient condition that rules every crossing out: each vector lies
 //   inside the region bounded by the two pieces (they meet only at their ends, so it is a simple
-//   polygon; whole closed curves: the ring between them cut along the first vector), since two chords of a simple polygon whose ends do not interleave along its
-//   boundary cannot cross, and an order-preserving matching's ends never interleave (start i,
-//   start j, end j, end i follow each other round the boundary). Vectors that leave the region
+//   polygon; whole closed curves: the ring between them cut along the first vector), since two chords of a simple
+//   polygon whose ends do not interleave along its boundary cannot cross, and an order-preserving matching's ends never
+//   interleave (start i, start j, end j, end i follow each other round the boundary). Vectors that leave the region
 //   (round a bend of either curve) are not covered by it, so no crossing-free result is
 //   promised: measured 0 on the bundled pairs, the shared frames and 60 fuzz pairs
 //   (bench/README.md).
@@ -57,8 +58,7 @@ struct MonotoneMatch {
 // the coarser path carried over by arc length (widened if the band admits no path). About
 // n * band * step transitions per level: linear in n.
 // InvalidInput naming "source", "start_rows", "target" or "stretch_weight" for bad input.
-MonotoneMatch monotone_match(const Points2Ref& source, const std::vector<Index>& start_rows,
-                             const Points2Ref& target,
+MonotoneMatch monotone_match(const Points2Ref& source, const std::vector<Index>& start_rows, const Points2Ref& target,
                              double stretch_weight = kDefaultStretchWeight);
 
 }  // namespace morphomap

@@ -7,10 +7,10 @@
 namespace morphomap {
 
 struct CurveQuality {
-  double qm1 = 0.0;    // < (L_i / (alpha l_i) - 1)^2 >
-  double qm2 = 0.0;    // < (A_i / <A> - 1)^2 >
-  double qm = 0.0;     // qm1 * qm2
-  Index crossings = 0; // pairs of vectors whose segments cross
+  double qm1 = 0.0;     // < (L_i / (alpha l_i) - 1)^2 >
+  double qm2 = 0.0;     // < (A_i / <A> - 1)^2 >
+  double qm = 0.0;      // qm1 * qm2
+  Index crossings = 0;  // pairs of vectors whose segments cross
 };
 
 // Quality of the vectors p_i -> P_i (p_i = field.starts[i] on c1, P_i = field.ends[i] on c2).
@@ -34,8 +34,7 @@ struct CurveQuality {
 // curve's bounding-box diagonal), else InvalidInput naming "field". Curves as in require_curve.
 // Cost: a bounding-volume hierarchy per curve to find the arc position of each point, then
 // O(M + vertices walked) in parallel; each area walks only the vertices between two points.
-CurveQuality quality(const DisplacementField2& field, const Points2Ref& c1, const Points2Ref& c2,
-                     bool closed = true);
+CurveQuality quality(const DisplacementField2& field, const Points2Ref& c1, const Points2Ref& c2, bool closed = true);
 
 }  // namespace morphomap
 
@@ -92,7 +91,7 @@ Index count_folds(const Points3Ref& starts, const Points3Ref& ends, const FacesR
 // Both surfaces must pass check_closed_surface (named "s1", "s2"); every valid start point must
 // lie on S1 and every valid end point on S2 within 1e-6 of the surface's bounding-box diagonal,
 // and field.faces must index the field's rows, else InvalidInput naming "field".
-SurfaceQuality quality(const DisplacementField3& field, const Points3Ref& v1, const FacesRef& f1,
-                       const Points3Ref& v2, const FacesRef& f2);
+SurfaceQuality quality(const DisplacementField3& field, const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2,
+                       const FacesRef& f2);
 
 }  // namespace morphomap

@@ -16,7 +16,6 @@ enum class ResampleMethod {
 // input points are dropped first. The spacing is length / n when closed, length / (n - 1) when
 // open. Needs n >= 3 (closed) or n >= 2 (open), and n <= 1e9. Throws InvalidInput naming
 // "points" or "n".
-Points2 resample(const Points2Ref& points, Index n, bool closed = true,
-                 ResampleMethod method = ResampleMethod::linear);
+Points2 resample(const Points2Ref& points, Index n, bool closed = true, ResampleMethod method = ResampleMethod::linear);
 
 }  // namespace morphomap

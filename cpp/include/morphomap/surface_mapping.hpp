@@ -20,7 +20,7 @@ struct SurfaceMappingOptions {
   //   minimal distance.
   // uniform has no 3D form: InvalidInput.
   MapMethod method = MapMethod::normal;
-  bool reverse = false;  // map S2 -> S1 and flip: starts on S1, ends on S2, rows and faces of S2
+  bool reverse = false;              // map S2 -> S1 and flip: starts on S1, ends on S2, rows and faces of S2
   double diffusion_mesh_size = 0.0;  // ShellDiffusionOptions::mesh_size (0: automatic)
 };
 
@@ -28,7 +28,7 @@ struct SurfaceMappingOptions {
 // vertices of the source surface (S1, or S2 when reversed), in its order; field.faces are its
 // faces. A vector that found nothing keeps its known point: NaN ends on forward vectors, NaN
 // starts on reverse ones (methods then name reverse_ variants).
-DisplacementField3 map_surfaces(const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2,
-                                const FacesRef& f2, const SurfaceMappingOptions& options = {});
+DisplacementField3 map_surfaces(const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2,
+                                const SurfaceMappingOptions& options = {});
 
 }  // namespace morphomap

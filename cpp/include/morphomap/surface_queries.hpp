@@ -34,8 +34,8 @@ class SurfaceIndex {
 };
 
 SurfaceHits closest_points(const Points3Ref& queries, const Points3Ref& vertices, const FacesRef& faces);
-SurfaceHits line_intersections(const Points3Ref& origins, const Points3Ref& directions,
-                               const Points3Ref& vertices, const FacesRef& faces);
+SurfaceHits line_intersections(const Points3Ref& origins, const Points3Ref& directions, const Points3Ref& vertices,
+                               const FacesRef& faces);
 
 // Unit normal at each vertex: the angle-weighted mean of the normals of the triangles around it;
 // outward on a closed surface whose triangles are oriented consistently.

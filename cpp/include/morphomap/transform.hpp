@@ -39,7 +39,6 @@ double overlap_area(const Points2Ref& a, const Points2Ref& b);
 // of C1's chord; tolerance is not used). InvalidInput names the argument: non-finite
 // coordinates, too few points, zero area (closed), a self-intersecting curve (closed),
 // coincident end points (open), a tolerance that is not positive and finite.
-Similarity2 align_curves(const Points2Ref& c1, const Points2Ref& c2, bool closed = true,
-                         double tolerance = 1e-6);
+Similarity2 align_curves(const Points2Ref& c1, const Points2Ref& c2, bool closed = true, double tolerance = 1e-6);
 
 }  // namespace morphomap

@@ -11,7 +11,7 @@ using Points2 = Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>;
 using Points3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 using Vector = Eigen::VectorXd;
 using IndexVector = Eigen::Matrix<Index, Eigen::Dynamic, 1>;
-using Faces = Eigen::Matrix<Index, Eigen::Dynamic, 3, Eigen::RowMajor>;        // triangles
+using Faces = Eigen::Matrix<Index, Eigen::Dynamic, 3, Eigen::RowMajor>;  // triangles
 using Tetrahedra = Eigen::Matrix<Index, Eigen::Dynamic, 4, Eigen::RowMajor>;
 
 // Read-only views that accept any matching Eigen expression or mapped buffer.

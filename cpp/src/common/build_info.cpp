@@ -3,9 +3,9 @@
 #include "common/validation.hpp"
 
 #include <CGAL/version_macros.h>
-#include <Eigen/Core>
 #include <embree3/rtcore.h>
 #include <tbb/version.h>
+#include <Eigen/Core>
 
 namespace morphomap {
 

@@ -30,8 +30,8 @@ inline int orient(const Point& a, const Point& b, const Point& c) {
 // For c collinear with a and b: whether c lies on the closed segment ab. Comparing coordinates
 // is exact, and for collinear points the bounding box test is the segment test.
 inline bool on_collinear_segment(const Point& a, const Point& b, const Point& c) {
-  return std::min(a.x(), b.x()) <= c.x() && c.x() <= std::max(a.x(), b.x()) &&
-         std::min(a.y(), b.y()) <= c.y() && c.y() <= std::max(a.y(), b.y());
+  return std::min(a.x(), b.x()) <= c.x() && c.x() <= std::max(a.x(), b.x()) && std::min(a.y(), b.y()) <= c.y() &&
+         c.y() <= std::max(a.y(), b.y());
 }
 
 // Whether the closed segments ab and cd have a point in common; either may be a single point.
@@ -87,9 +87,8 @@ class PairTester {
   static constexpr std::size_t batch_size = std::size_t(1) << 20;
   void flush() {
     flags_.assign(batch_.size(), 0);
-    tbb::parallel_for(std::size_t(0), batch_.size(), [&](std::size_t k) {
-      flags_[k] = keep_(batch_[k].first, batch_[k].second) ? 1 : 0;
-    });
+    tbb::parallel_for(std::size_t(0), batch_.size(),
+                      [&](std::size_t k) { flags_[k] = keep_(batch_[k].first, batch_[k].second) ? 1 : 0; });
     for (std::size_t k = 0; k < batch_.size(); ++k) {
       if (!flags_[k]) continue;
       ++count_;
@@ -123,8 +122,8 @@ Index test_overlapping_pairs(std::vector<SegmentBox> boxes, const Keep& keep, In
 // The same for pairs (i, j), box i of `first` overlapping box j of `second`; the boxes' index
 // fields are positions in their own set.
 template <class Keep>
-Index test_overlapping_pairs(std::vector<SegmentBox> first, std::vector<SegmentBox> second,
-                             const Keep& keep, IndexPairs* kept = nullptr) {
+Index test_overlapping_pairs(std::vector<SegmentBox> first, std::vector<SegmentBox> second, const Keep& keep,
+                             IndexPairs* kept = nullptr) {
   const std::size_t offset = first.size();
   for (SegmentBox& box : second) box.index += offset;
   PairTester<Keep> tester(keep, kept);

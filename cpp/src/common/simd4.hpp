@@ -59,17 +59,32 @@ struct F4 {
   float v[4];
   static F4 load(const float* p) { return {{p[0], p[1], p[2], p[3]}}; }
   static F4 all(float x) { return {{x, x, x, x}}; }
-  template <class Op> static F4 map(F4 a, F4 b, Op op) {
+  template <class Op>
+  static F4 map(F4 a, F4 b, Op op) {
     return {{op(a.v[0], b.v[0]), op(a.v[1], b.v[1]), op(a.v[2], b.v[2]), op(a.v[3], b.v[3])}};
   }
-  friend F4 operator+(F4 a, F4 b) { return map(a, b, [](float x, float y) { return x + y; }); }
-  friend F4 operator-(F4 a, F4 b) { return map(a, b, [](float x, float y) { return x - y; }); }
-  friend F4 operator*(F4 a, F4 b) { return map(a, b, [](float x, float y) { return x * y; }); }
-  friend F4 operator&(F4 a, F4 b) { return map(a, b, [](float x, float y) { return x != 0 && y != 0 ? 1.0f : 0.0f; }); }
-  friend F4 operator|(F4 a, F4 b) { return map(a, b, [](float x, float y) { return x != 0 || y != 0 ? 1.0f : 0.0f; }); }
+  friend F4 operator+(F4 a, F4 b) {
+    return map(a, b, [](float x, float y) { return x + y; });
+  }
+  friend F4 operator-(F4 a, F4 b) {
+    return map(a, b, [](float x, float y) { return x - y; });
+  }
+  friend F4 operator*(F4 a, F4 b) {
+    return map(a, b, [](float x, float y) { return x * y; });
+  }
+  friend F4 operator&(F4 a, F4 b) {
+    return map(a, b, [](float x, float y) { return x != 0 && y != 0 ? 1.0f : 0.0f; });
+  }
+  friend F4 operator|(F4 a, F4 b) {
+    return map(a, b, [](float x, float y) { return x != 0 || y != 0 ? 1.0f : 0.0f; });
+  }
   friend F4 abs(F4 a) { return {{std::abs(a.v[0]), std::abs(a.v[1]), std::abs(a.v[2]), std::abs(a.v[3])}}; }
-  friend F4 max(F4 a, F4 b) { return map(a, b, [](float x, float y) { return x > y ? x : y; }); }
-  friend F4 le(F4 a, F4 b) { return map(a, b, [](float x, float y) { return x <= y ? 1.0f : 0.0f; }); }
+  friend F4 max(F4 a, F4 b) {
+    return map(a, b, [](float x, float y) { return x > y ? x : y; });
+  }
+  friend F4 le(F4 a, F4 b) {
+    return map(a, b, [](float x, float y) { return x <= y ? 1.0f : 0.0f; });
+  }
   friend int bits(F4 mask) {
     return (mask.v[0] != 0) | (mask.v[1] != 0) << 1 | (mask.v[2] != 0) << 2 | (mask.v[3] != 0) << 3;
   }

@@ -13,9 +13,7 @@
 
 namespace morphomap::detail {
 
-void invalid(const char* name, const std::string& problem) {
-  throw InvalidInput(std::string(name) + ": " + problem);
-}
+void invalid(const char* name, const std::string& problem) { throw InvalidInput(std::string(name) + ": " + problem); }
 
 void require_finite(const Points2Ref& points, const char* name) {
   for (Index i = 0; i < points.rows(); ++i) {

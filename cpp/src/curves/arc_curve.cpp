@@ -46,6 +46,10 @@ Index ArcCurve::segment_at(double s) const {
   return std::max<Index>(0, (it - arc_.data()) - 1);
 }
 
+Index ArcCurve::vertex_after(double s) const {
+  return std::upper_bound(arc_.data(), arc_.data() + size(), s) - arc_.data();
+}
+
 Vec2 ArcCurve::point_at(double s) const {
   s = wrap(s);
   const Index i = segment_at(s);

@@ -28,10 +28,12 @@ class ArcCurve {
   // The polyline from position a to position b: forward (wrapping) on a closed curve, in the
   // direction of b on an open one; both end points included, the vertices between in order.
   Points2 piece(double a, double b) const;
+  // The segment containing the wrapped position s: the last one starting at or before it.
+  Index segment_at(double s) const;
+  // The first vertex whose arc position lies after s (size() if none).
+  Index vertex_after(double s) const;
 
  private:
-  Index segment_at(double s) const;  // segment containing the wrapped position s
-
   Points2 points_;
   Vector arc_;  // size() + 1 entries
   bool closed_;

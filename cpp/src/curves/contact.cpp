@@ -22,31 +22,20 @@ double median_segment(const ArcCurve& curve) {
   return *middle;
 }
 
-// First vertex whose arc position lies after s (size() if none).
-Index vertex_after(const ArcCurve& curve, double s) {
-  Index lo = 0, hi = curve.size();
-  while (lo < hi) {
-    const Index mid = lo + (hi - lo) / 2;
-    if (curve.arc(mid) <= s) lo = mid + 1;
-    else hi = mid;
-  }
-  return lo;
-}
-
 // Whether every vertex of the curve strictly inside the shorter way between positions a and b is
 // marked in `near`.
 bool vertices_between_near(const ArcCurve& curve, double a, double b, const std::vector<char>& near) {
   const Index n = curve.size();
   if (!curve.closed()) {
     if (b < a) std::swap(a, b);
-    for (Index v = vertex_after(curve, a); v < n && curve.arc(v) < b; ++v) {
+    for (Index v = curve.vertex_after(a); v < n && curve.arc(v) < b; ++v) {
       if (!near[v]) return false;
     }
     return true;
   }
   if (curve.forward(a, b) > curve.forward(b, a)) std::swap(a, b);
   const double span = curve.forward(a, b);
-  Index v = vertex_after(curve, a);
+  Index v = curve.vertex_after(a);
   for (Index step = 0; step < n; ++step, ++v) {
     const Index w = v % n;
     const double d = curve.forward(a, curve.arc(w));
@@ -62,8 +51,8 @@ double default_contact_tolerance(const ArcCurve& source, const ArcCurve& target)
   return 0.01 * std::min(median_segment(source), median_segment(target));
 }
 
-std::vector<Meeting> find_meetings(const ArcCurve& source, const ArcCurve& target,
-                                   const CurveIntersections& crossings, double tolerance) {
+std::vector<Meeting> find_meetings(const ArcCurve& source, const ArcCurve& target, const CurveIntersections& crossings,
+                                   double tolerance) {
   const Index n = source.size();
   const bool closed = source.closed();
   const CurveHits to_target = CurveIndex(target.points(), target.closed()).closest_points(source.points());
@@ -122,7 +111,8 @@ std::vector<Meeting> find_meetings(const ArcCurve& source, const ArcCurve& targe
       }
     }
   }
-  std::sort(runs.begin(), runs.end(), [](const Meeting& a, const Meeting& b) { return a.source_begin < b.source_begin; });
+  std::sort(runs.begin(), runs.end(),
+            [](const Meeting& a, const Meeting& b) { return a.source_begin < b.source_begin; });
 
   std::vector<Meeting> meetings = runs;
   const double length = source.length();
@@ -149,8 +139,8 @@ std::vector<Meeting> find_meetings(const ArcCurve& source, const ArcCurve& targe
   return meetings;
 }
 
-std::vector<Meeting> meetings_in_order(const std::vector<Meeting>& meetings, const ArcCurve& target,
-                                       int direction, bool* all_in_order) {
+std::vector<Meeting> meetings_in_order(const std::vector<Meeting>& meetings, const ArcCurve& target, int direction,
+                                       bool* all_in_order) {
   std::vector<Meeting> kept;
   *all_in_order = true;
   if (meetings.empty()) return kept;

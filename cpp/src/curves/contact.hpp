@@ -33,13 +33,13 @@ double default_contact_tolerance(const ArcCurve& source, const ArcCurve& target)
 // between their closest points also stays within `tolerance` of the source (so a run does not
 // jump across a gap); a single such vertex is a touching point. Crossings that lie on a stretch
 // (within the tolerance) belong to it; the others are meetings of their own.
-std::vector<Meeting> find_meetings(const ArcCurve& source, const ArcCurve& target,
-                                   const CurveIntersections& crossings, double tolerance);
+std::vector<Meeting> find_meetings(const ArcCurve& source, const ArcCurve& target, const CurveIntersections& crossings,
+                                   double tolerance);
 
 // The meetings whose target positions follow each other along the target in `direction`
 // (+1 forward, -1 backward), in source order: all of them when they already do, else a greedy
 // subsequence (pieces between meetings that do not can not be paired).
-std::vector<Meeting> meetings_in_order(const std::vector<Meeting>& meetings, const ArcCurve& target,
-                                       int direction, bool* all_in_order);
+std::vector<Meeting> meetings_in_order(const std::vector<Meeting>& meetings, const ArcCurve& target, int direction,
+                                       bool* all_in_order);
 
 }  // namespace morphomap::detail

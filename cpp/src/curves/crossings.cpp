@@ -17,8 +17,8 @@
 #include <optional>
 #include <queue>
 #include <set>
-#include <type_traits>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -68,8 +68,8 @@ struct Segments {
 
 Segments read_segments(const Points2Ref& starts, const Points2Ref& ends) {
   if (starts.rows() != ends.rows()) {
-    detail::invalid("ends", "has " + std::to_string(ends.rows()) + " rows but starts has " +
-                                std::to_string(starts.rows()));
+    detail::invalid("ends",
+                    "has " + std::to_string(ends.rows()) + " rows but starts has " + std::to_string(starts.rows()));
   }
   Segments s;
   const Index n = starts.rows();
@@ -318,7 +318,8 @@ class Sweep {
     continuing_.clear();
     continuing_.insert(continuing_.end(), through_.begin(), through_.end());
     continuing_.insert(continuing_.end(), starting_.begin(), starting_.end());
-    std::sort(continuing_.begin(), continuing_.end(), [this](std::uint32_t i, std::uint32_t j) { return slope_less(i, j); });
+    std::sort(continuing_.begin(), continuing_.end(),
+              [this](std::uint32_t i, std::uint32_t j) { return slope_less(i, j); });
     for (const std::uint32_t i : continuing_) status_.insert(hi, i);
     const bool has_above = hi != status_.end();
     if (continuing_.empty()) {
@@ -348,8 +349,8 @@ class Sweep {
       std::sort(ending_.begin(), ending_.end(), [this](std::uint32_t i, std::uint32_t j) { return slope_less(i, j); });
       for (const std::uint32_t c : through_) {
         // The segments ending at p that are collinear with c: one run of ending_.
-        const auto first = std::partition_point(ending_.begin(), ending_.end(),
-                                                [&](std::uint32_t e) { return slope(e, c) < 0; });
+        const auto first =
+            std::partition_point(ending_.begin(), ending_.end(), [&](std::uint32_t e) { return slope(e, c) < 0; });
         auto last = first;
         while (last != ending_.end() && slope(*last, c) == 0) ++last;
         for (auto e = ending_.begin(); e != first; ++e) report_(c, *e);
@@ -357,7 +358,8 @@ class Sweep {
       }
     }
     if (starting_.size() > 1) {
-      std::sort(starting_.begin(), starting_.end(), [this](std::uint32_t i, std::uint32_t j) { return slope_less(i, j); });
+      std::sort(starting_.begin(), starting_.end(),
+                [this](std::uint32_t i, std::uint32_t j) { return slope_less(i, j); });
       for (std::size_t k = 0; k < starting_.size();) {
         std::size_t end = k + 1;
         while (end < starting_.size() && slope(starting_[k], starting_[end]) == 0) ++end;
@@ -412,10 +414,14 @@ bool crossing(const Segments& s, std::size_t i, std::size_t j) {
   if (!detail::segments_meet(a, b, c, d)) return false;
   const Point* x = nullptr;
   const Point *u = nullptr, *w = nullptr;
-  if (a == c) x = &a, u = &b, w = &d;
-  else if (a == d) x = &a, u = &b, w = &c;
-  else if (b == c) x = &b, u = &a, w = &d;
-  else if (b == d) x = &b, u = &a, w = &c;
+  if (a == c)
+    x = &a, u = &b, w = &d;
+  else if (a == d)
+    x = &a, u = &b, w = &c;
+  else if (b == c)
+    x = &b, u = &a, w = &d;
+  else if (b == d)
+    x = &b, u = &a, w = &c;
   if (x == nullptr) return true;
   // A shared end point x: they meet elsewhere only if collinear and leaving x the same way.
   return detail::orient(*x, *u, *w) == 0 && CGAL::angle(*u, *x, *w) == CGAL::ACUTE;

@@ -13,9 +13,7 @@
 namespace morphomap {
 namespace {
 
-double distance(const Points2Ref& p, Index i, Index j) {
-  return std::hypot(p(j, 0) - p(i, 0), p(j, 1) - p(i, 1));
-}
+double distance(const Points2Ref& p, Index i, Index j) { return std::hypot(p(j, 0) - p(i, 0), p(j, 1) - p(i, 1)); }
 
 // Exact sign of the shoelace sum over the first n rows. The interval sum decides nearly always;
 // MP_Float (exact for sums of products of doubles) settles the rest.
@@ -34,8 +32,7 @@ int area_sign(const Points2Ref& p, Index n) {
   CGAL::MP_Float sum(0);
   for (Index i = 0; i < n; ++i) {
     const Index j = (i + 1) % n;
-    sum += CGAL::MP_Float(p(i, 0)) * CGAL::MP_Float(p(j, 1)) -
-           CGAL::MP_Float(p(j, 0)) * CGAL::MP_Float(p(i, 1));
+    sum += CGAL::MP_Float(p(i, 0)) * CGAL::MP_Float(p(j, 1)) - CGAL::MP_Float(p(j, 0)) * CGAL::MP_Float(p(i, 1));
   }
   return static_cast<int>(CGAL::sign(sum));
 }

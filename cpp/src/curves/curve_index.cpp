@@ -26,8 +26,7 @@ CurveHits allocate_hits(Index rows) {
 
 }  // namespace
 
-CurveIndex::CurveIndex(const Points2Ref& curve, bool closed)
-    : impl_(std::make_unique<Impl>(curve, closed)) {}
+CurveIndex::CurveIndex(const Points2Ref& curve, bool closed) : impl_(std::make_unique<Impl>(curve, closed)) {}
 CurveIndex::~CurveIndex() = default;
 CurveIndex::CurveIndex(CurveIndex&&) noexcept = default;
 CurveIndex& CurveIndex::operator=(CurveIndex&&) noexcept = default;
@@ -42,13 +41,12 @@ CurveHits CurveIndex::closest_points(const Points2Ref& queries) const {
   return hits;
 }
 
-CurveHits CurveIndex::line_intersections(const Points2Ref& origins,
-                                         const Points2Ref& directions) const {
+CurveHits CurveIndex::line_intersections(const Points2Ref& origins, const Points2Ref& directions) const {
   detail::require_finite(origins, "origins");
   detail::require_finite(directions, "directions");
   if (origins.rows() != directions.rows()) {
-    detail::invalid("directions", "has " + std::to_string(directions.rows()) +
-                                      " rows but origins has " + std::to_string(origins.rows()));
+    detail::invalid("directions", "has " + std::to_string(directions.rows()) + " rows but origins has " +
+                                      std::to_string(origins.rows()));
   }
   for (Index i = 0; i < directions.rows(); ++i) {
     if (directions(i, 0) == 0.0 && directions(i, 1) == 0.0) {
@@ -64,8 +62,8 @@ CurveHits closest_points(const Points2Ref& queries, const Points2Ref& curve, boo
   return CurveIndex(curve, closed).closest_points(queries);
 }
 
-CurveHits line_intersections(const Points2Ref& origins, const Points2Ref& directions,
-                             const Points2Ref& curve, bool closed) {
+CurveHits line_intersections(const Points2Ref& origins, const Points2Ref& directions, const Points2Ref& curve,
+                             bool closed) {
   return CurveIndex(curve, closed).line_intersections(origins, directions);
 }
 

@@ -24,12 +24,11 @@ using detail::Point;
 struct Curve {
   Points2 q;
   std::vector<Point> p;
-  Vector s;                     // arc length at each point
-  std::vector<Index> segment;   // input segment index of each segment
+  Vector s;                    // arc length at each point
+  std::vector<Index> segment;  // input segment index of each segment
   Index segments;
 
-  Curve(const Points2Ref& points, bool closed, const char* name)
-      : q(detail::without_repeats(points, closed, name)) {
+  Curve(const Points2Ref& points, bool closed, const char* name) : q(detail::without_repeats(points, closed, name)) {
     const Index m = q.rows();
     segments = closed ? m : m - 1;
     p.resize(m);
@@ -48,7 +47,6 @@ struct Curve {
     return b;
   }
 };
-
 
 // Sign of orient(a, b, c + εv), v = (1, δ), δ ≪ 1: the exact sign, or when c lies on the line
 // ab, the sign of cross(b - a, v).
@@ -89,7 +87,7 @@ struct Crossing {
   Vec2 point;
   Index seg1, seg2;  // segments of the curves without repeats
   double s1, s2;
-  Index i, j;        // the segments as found, before a crossing at t = 1 moved to the next one
+  Index i, j;  // the segments as found, before a crossing at t = 1 moved to the next one
 };
 
 // The exact intersection point of segment i of c1 with the line of segment j of c2.
@@ -158,9 +156,8 @@ std::vector<Index> drop_touches(const Curve& c1, const Curve& c2, const std::vec
     changed = false;
     const std::size_t k = order.size();
     std::vector<Index> by2(order);
-    std::stable_sort(by2.begin(), by2.end(), [&](Index a, Index b) {
-      return std::tie(x[a].s2, x[a].s1) < std::tie(x[b].s2, x[b].s1);
-    });
+    std::stable_sort(by2.begin(), by2.end(),
+                     [&](Index a, Index b) { return std::tie(x[a].s2, x[a].s1) < std::tie(x[b].s2, x[b].s1); });
     std::vector<std::size_t> rank2(x.size());
     for (std::size_t r = 0; r < k; ++r) rank2[by2[r]] = r;
     const auto neighbours2 = [&](Index a, Index b) {
@@ -199,9 +196,8 @@ CurveIntersections curve_intersections(const Points2Ref& c1, const Points2Ref& c
   for (const auto& [i, j] : hits) x.push_back(make_crossing(a, i, b, j, closed));
   std::vector<Index> order(x.size());
   std::iota(order.begin(), order.end(), Index(0));
-  std::stable_sort(order.begin(), order.end(), [&](Index u, Index v) {
-    return std::tie(x[u].s1, x[u].s2) < std::tie(x[v].s1, x[v].s2);
-  });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](Index u, Index v) { return std::tie(x[u].s1, x[u].s2) < std::tie(x[v].s1, x[v].s2); });
   order = drop_touches(a, b, x, order, closed);
 
   CurveIntersections out;

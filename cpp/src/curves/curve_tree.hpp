@@ -8,7 +8,6 @@
 
 #include "common/hit_order.hpp"
 #include "common/numbers.hpp"
-#include "common/numbers.hpp"
 #include "common/simd4.hpp"
 
 #include <array>
@@ -19,8 +18,8 @@
 
 namespace morphomap::curve_tree {
 
-using detail::kNaN;
 using detail::kInf;
+using detail::kNaN;
 
 using simd4::F4;
 
@@ -96,7 +95,7 @@ struct Segment {
   double ax, ay, ex, ey;
   double start_arc;  // arc length at a
   double length;
-  std::int64_t id;   // index in the curve: from point id to point id + 1
+  std::int64_t id;  // index in the curve: from point id to point id + 1
 };
 
 // A line o + t u with |u| = 1.
@@ -160,8 +159,8 @@ struct Tree {
 
   // Pushes the kept children but the nearest onto the stack, farthest first, and makes the
   // nearest the current one; false when no child is kept.
-  static bool descend(double* bound, std::int64_t* ref, int kept, std::int64_t* stack, double* stack_bound,
-                      int& top, std::int64_t& current, double& current_bound);
+  static bool descend(double* bound, std::int64_t* ref, int kept, std::int64_t* stack, double* stack_bound, int& top,
+                      std::int64_t& current, double& current_bound);
 
   Hit closest(double qx, double qy) const;
 

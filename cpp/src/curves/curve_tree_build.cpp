@@ -62,8 +62,7 @@ std::int32_t Tree::split(std::int32_t begin, std::int32_t end) {
   const std::int32_t middle = begin + (end - begin) / 2;
   std::nth_element(segments.begin() + begin, segments.begin() + middle, segments.begin() + end,
                    [axis](const Segment& a, const Segment& b) {
-                     return axis == 0 ? a.ax + 0.5 * a.ex < b.ax + 0.5 * b.ex
-                                      : a.ay + 0.5 * a.ey < b.ay + 0.5 * b.ey;
+                     return axis == 0 ? a.ax + 0.5 * a.ex < b.ax + 0.5 * b.ex : a.ay + 0.5 * a.ey < b.ay + 0.5 * b.ey;
                    });
   return middle;
 }
@@ -154,7 +153,8 @@ std::int32_t Tree::make_leaf(std::int32_t begin, std::int32_t end) {
       group.ax[k] = static_cast<float>(ax), group.ay[k] = static_cast<float>(ay);
       group.bx[k] = static_cast<float>(ax + s.ex * scale), group.by[k] = static_cast<float>(ay + s.ey * scale);
       group.slack[k] = float_up(kFloatSlack * std::max(std::abs(group.ax[k]) + std::abs(group.ay[k]),
-                                                       std::abs(group.bx[k]) + std::abs(group.by[k])) + 1e-30);
+                                                       std::abs(group.bx[k]) + std::abs(group.by[k])) +
+                                1e-30);
       group.segment[k] = i;
     }
     groups.push_back(group);

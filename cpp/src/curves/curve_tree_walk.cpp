@@ -25,8 +25,7 @@ void store(CurveHits& hits, Index i, const Hit& hit) {
   hits.points(i, 1) = hit.y;
   hits.distances[i] = hit.segment ? hit.distance : kNaN;
   hits.segments[i] = hit.segment ? hit.segment->id : -1;
-  hits.arc_lengths[i] =
-      hit.segment ? hit.segment->start_arc + hit.s * hit.segment->length : kNaN;
+  hits.arc_lengths[i] = hit.segment ? hit.segment->start_arc + hit.s * hit.segment->length : kNaN;
 }
 
 }  // namespace
@@ -46,8 +45,8 @@ void Tree::order(double* bound, std::int64_t* ref) {
 
 // Pushes the kept children but the nearest onto the stack, farthest first, and makes the
 // nearest the current one; false when no child is kept.
-bool Tree::descend(double* bound, std::int64_t* ref, int kept, std::int64_t* stack, double* stack_bound,
-                   int& top, std::int64_t& current, double& current_bound) {
+bool Tree::descend(double* bound, std::int64_t* ref, int kept, std::int64_t* stack, double* stack_bound, int& top,
+                   std::int64_t& current, double& current_bound) {
   if (kept == 0) return false;
   order(bound, ref);
   for (int k = kept - 1; k > 0; --k) stack[top] = ref[k], stack_bound[top++] = bound[k];
@@ -221,9 +220,7 @@ void Tree::visit(const Segment& s, const Line& l, Hit& best) {
   // its point nearest to the origin is the origin itself or an end.
   if (ux * wy - uy * wx != 0.0) return;
   const double t0 = ux * wx + uy * wy, t1 = t0 + ux * s.ex + uy * s.ey;
-  const double t = std::min(t0, t1) > 0.0   ? std::min(t0, t1)
-                   : std::max(t0, t1) < 0.0 ? std::max(t0, t1)
-                                            : 0.0;
+  const double t = std::min(t0, t1) > 0.0 ? std::min(t0, t1) : std::max(t0, t1) < 0.0 ? std::max(t0, t1) : 0.0;
   const double sp = t1 != t0 ? (t - t0) / (t1 - t0) : 0.0;
   if ((!best.segment || detail::line_hit_before(t, s.id, best.distance, best.segment->id))) {
     best.x = s.ax + sp * s.ex, best.y = s.ay + sp * s.ey;
@@ -232,49 +229,46 @@ void Tree::visit(const Segment& s, const Line& l, Hit& best) {
 }
 
 void Tree::closest_points(const Points2Ref& queries, CurveHits& hits) const {
-  tbb::parallel_for(tbb::blocked_range<Index>(0, queries.rows(), kGrain),
-                    [&](const tbb::blocked_range<Index>& range) {
-                      for (Index i = range.begin(); i < range.end(); ++i) {
-                        store(hits, i, closest(queries(i, 0), queries(i, 1)));
-                      }
-                    });
+  tbb::parallel_for(tbb::blocked_range<Index>(0, queries.rows(), kGrain), [&](const tbb::blocked_range<Index>& range) {
+    for (Index i = range.begin(); i < range.end(); ++i) {
+      store(hits, i, closest(queries(i, 0), queries(i, 1)));
+    }
+  });
 }
 
-void Tree::line_intersections(const Points2Ref& origins, const Points2Ref& directions,
-                              CurveHits& hits) const {
-  tbb::parallel_for(tbb::blocked_range<Index>(0, origins.rows(), kGrain),
-                    [&](const tbb::blocked_range<Index>& range) {
-                      // kWalks lines at a time, each slot refilled with the next line as its
-                      // walk ends.
-                      constexpr int kWalks = 4;
-                      LineWalk walk[kWalks];
-                      Index which[kWalks];
-                      bool live[kWalks];
-                      Index next = range.begin();
-                      auto refill = [&](int k) {
-                        while (next < range.end()) {
-                          const Index i = next++;
-                          const double dx = directions(i, 0), dy = directions(i, 1);
-                          const double norm = std::sqrt(dx * dx + dy * dy);
-                          if (start(walk[k], {origins(i, 0), origins(i, 1), dx / norm, dy / norm})) {
-                            which[k] = i;
-                            return true;
-                          }
-                          store(hits, i, walk[k].best);
-                        }
-                        return false;
-                      };
-                      int running = 0;
-                      for (int k = 0; k < kWalks; ++k) running += live[k] = refill(k);
-                      while (running > 0) {
-                        for (int k = 0; k < kWalks; ++k) {
-                          if (live[k] && !step(walk[k])) {
-                            store(hits, which[k], walk[k].best);
-                            running -= !(live[k] = refill(k));
-                          }
-                        }
-                      }
-                    });
+void Tree::line_intersections(const Points2Ref& origins, const Points2Ref& directions, CurveHits& hits) const {
+  tbb::parallel_for(tbb::blocked_range<Index>(0, origins.rows(), kGrain), [&](const tbb::blocked_range<Index>& range) {
+    // kWalks lines at a time, each slot refilled with the next line as its
+    // walk ends.
+    constexpr int kWalks = 4;
+    LineWalk walk[kWalks];
+    Index which[kWalks];
+    bool live[kWalks];
+    Index next = range.begin();
+    auto refill = [&](int k) {
+      while (next < range.end()) {
+        const Index i = next++;
+        const double dx = directions(i, 0), dy = directions(i, 1);
+        const double norm = std::sqrt(dx * dx + dy * dy);
+        if (start(walk[k], {origins(i, 0), origins(i, 1), dx / norm, dy / norm})) {
+          which[k] = i;
+          return true;
+        }
+        store(hits, i, walk[k].best);
+      }
+      return false;
+    };
+    int running = 0;
+    for (int k = 0; k < kWalks; ++k) running += live[k] = refill(k);
+    while (running > 0) {
+      for (int k = 0; k < kWalks; ++k) {
+        if (live[k] && !step(walk[k])) {
+          store(hits, which[k], walk[k].best);
+          running -= !(live[k] = refill(k));
+        }
+      }
+    }
+  });
 }
 
 }  // namespace morphomap::curve_tree

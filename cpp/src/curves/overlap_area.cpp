@@ -27,7 +27,6 @@ namespace {
 
 using detail::Point;
 
-
 // The curve without repeats and counter-clockwise.
 Points2 counter_clockwise(const Points2Ref& points, const char* name) {
   int turn = 0;
@@ -121,8 +120,7 @@ Cuts cuts_along(const CurveIntersections& x, bool first) {
 // Whether the first piece (from cut 0 to cut 1) of `curve` lies inside `other`, under the shift:
 // the curve's points are tested with the shift s (+1 for the shifted second curve, -1 for the
 // first curve, as seen from the second). Parity then gives every other piece.
-bool first_piece_inside(const Points2& curve, const Vector& arc, const Cuts& c,
-                        const Points2& other, int s) {
+bool first_piece_inside(const Points2& curve, const Vector& arc, const Cuts& c, const Points2& other, int s) {
   const Index n = curve.rows();
   const Index k = static_cast<Index>(c.segment.size());
   // A vertex that is not a crossing: exactly classified, and its piece is exactly known. Vertex
@@ -138,8 +136,7 @@ bool first_piece_inside(const Points2& curve, const Vector& arc, const Cuts& c,
       on_cut = c.arc[r] <= arc(i) || c.points[r] == curve.row(i).transpose();
     }
     if (on_cut || c.points[at > 0 ? at - 1 : k - 1] == curve.row(i).transpose()) continue;
-    const bool in =
-        inside_shifted(other, curve.row(i).transpose(), curve.row((i + 1) % n).transpose(), s);
+    const bool in = inside_shifted(other, curve.row(i).transpose(), curve.row((i + 1) % n).transpose(), s);
     // Vertex i lies on the piece that starts at cut before - 1 (the last piece, wrapping, when
     // before == 0).
     const Index piece = (before + k - 1) % k;
@@ -153,8 +150,7 @@ bool first_piece_inside(const Points2& curve, const Vector& arc, const Cuts& c,
   for (Index r = 0; r < k; ++r) {
     const Index next = (r + 1) % k;
     const Vec2 a = c.points[r], b = c.points[next];
-    const bool whole = a == curve.row(c.segment[r]).transpose() &&
-                       b == curve.row((c.segment[r] + 1) % n).transpose();
+    const bool whole = a == curve.row(c.segment[r]).transpose() && b == curve.row((c.segment[r] + 1) % n).transpose();
     if (whole && a != b) return inside_shifted_midpoint(other, a, b, s) != (r % 2 == 1);
     const double length = (b - a).norm();
     if (length > longest) longest = length, best = r;
@@ -192,8 +188,7 @@ double twice_area(const Points2& p, const Vec2& origin) {
   double twice = 0.0;
   for (Index i = 0; i < n; ++i) {
     const Index j = (i + 1) % n;
-    twice += (p(i, 0) - origin.x()) * (p(j, 1) - origin.y()) -
-             (p(j, 0) - origin.x()) * (p(i, 1) - origin.y());
+    twice += (p(i, 0) - origin.x()) * (p(j, 1) - origin.y()) - (p(j, 0) - origin.x()) * (p(i, 1) - origin.y());
   }
   return twice;
 }
@@ -232,8 +227,7 @@ double overlap_area(const Points2Ref& a, const Points2Ref& b) {
   const Cuts ca = cuts_along(x, true), cb = cuts_along(x, false);
   const bool a_first = first_piece_inside(pa, arc_positions(pa), ca, pb, -1);
   const bool b_first = first_piece_inside(pb, arc_positions(pb), cb, pa, +1);
-  const double twice =
-      inside_pieces(pa, ca, a_first, origin) + inside_pieces(pb, cb, b_first, origin);
+  const double twice = inside_pieces(pa, ca, a_first, origin) + inside_pieces(pb, cb, b_first, origin);
   return std::max(0.0, 0.5 * twice);
 }
 

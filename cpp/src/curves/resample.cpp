@@ -8,8 +8,8 @@
 
 #include <algorithm>
 #include <array>
-#include <limits>
 #include <cmath>
+#include <limits>
 #include <string>
 
 namespace morphomap {
@@ -59,8 +59,7 @@ constexpr double quad_rtol = 1e-14;
 // Arc length of the pieces of one curve: speed |P'(s)| integrated by adaptive Gauss-Legendre.
 class ArcLength {
  public:
-  explicit ArcLength(const PiecewiseCubic& curve, bool straight)
-      : curve_(curve), straight_(straight) {}
+  explicit ArcLength(const PiecewiseCubic& curve, bool straight) : curve_(curve), straight_(straight) {}
 
   // Length of piece i from s = 0 to s, with absolute tolerance tol.
   double length(Index i, double s, double tol) const {
@@ -96,8 +95,7 @@ class ArcLength {
     // A non-finite speed (pieces too short for their slopes to be represented) cannot converge:
     // the caller rejects the length.
     if (depth == 0 || !std::isfinite(both) || std::abs(both - whole) <= std::max(tol, floor)) return both;
-    return adapt(i, a, m, left, 0.5 * tol, depth - 1) +
-           adapt(i, m, b, right, 0.5 * tol, depth - 1);
+    return adapt(i, a, m, left, 0.5 * tol, depth - 1) + adapt(i, m, b, right, 0.5 * tol, depth - 1);
   }
 
   const PiecewiseCubic& curve_;
@@ -145,13 +143,11 @@ Points2 resample(const Points2Ref& points, Index n, bool closed, ResampleMethod 
   const Points2 p = detail::without_repeats(points, closed, "points");
   const Index min_n = closed ? 3 : 2;
   if (n < min_n) {
-    detail::invalid("n", std::string("resampling a") + (closed ? " closed" : "n open") +
-                             " curve needs at least " + std::to_string(min_n) + " points, got " +
-                             std::to_string(n));
+    detail::invalid("n", std::string("resampling a") + (closed ? " closed" : "n open") + " curve needs at least " +
+                             std::to_string(min_n) + " points, got " + std::to_string(n));
   }
   if (n > max_points) {
-    detail::invalid("n", "at most " + std::to_string(max_points) + " points, got " +
-                             std::to_string(n));
+    detail::invalid("n", "at most " + std::to_string(max_points) + " points, got " + std::to_string(n));
   }
 
   const PiecewiseCubic curve = interpolant(p, closed, method);
@@ -162,8 +158,9 @@ Points2 resample(const Points2Ref& points, Index n, bool closed, ResampleMethod 
     detail::invalid("points", "the curve is too long to measure (its length overflows)");
   }
   if (!straight && curve.h.minCoeff() < std::numeric_limits<double>::min()) {
-    detail::invalid("points", "consecutive points too close together to fit a curve through them (closer "
-                              "than the smallest normal double)");
+    detail::invalid("points",
+                    "consecutive points too close together to fit a curve through them (closer "
+                    "than the smallest normal double)");
   }
 
   // Length of each piece, then cumulative lengths with compensated summation so that the
@@ -198,8 +195,7 @@ Points2 resample(const Points2Ref& points, Index n, bool closed, ResampleMethod 
       Index i = std::upper_bound(start.data(), start.data() + pieces, target) - start.data() - 1;
       i = std::clamp<Index>(i, 0, pieces - 1);
       const double r = std::clamp(target - start(i), 0.0, piece_length(i));
-      const double s = straight ? std::min(r, curve.h(i))
-                                : invert(arc, i, curve.h(i), piece_length(i), r);
+      const double s = straight ? std::min(r, curve.h(i)) : invert(arc, i, curve.h(i), piece_length(i), r);
       out.row(k) = curve.position(i, s).transpose();
     }
   });

@@ -56,8 +56,8 @@ void hermite(const Points2& p, const Points2& t, const Chords& ch, PiecewiseCubi
 
 // Solves the tridiagonal system sub[i] x[i-1] + diag[i] x[i] + sup[i] x[i+1] = rhs[i] (Thomas;
 // no pivoting, which the diagonally dominant spline systems do not need). Two right-hand sides.
-Points2 solve_tridiagonal(const std::vector<double>& sub, std::vector<double> diag,
-                          const std::vector<double>& sup, Points2 rhs) {
+Points2 solve_tridiagonal(const std::vector<double>& sub, std::vector<double> diag, const std::vector<double>& sup,
+                          Points2 rhs) {
   const Index n = rhs.rows();
   for (Index i = 1; i < n; ++i) {
     const double w = sub[i] / diag[i - 1];
@@ -73,8 +73,8 @@ Points2 solve_tridiagonal(const std::vector<double>& sub, std::vector<double> di
 
 // Same with the corner entries sub[0] (row 0, column n-1) and sup[n-1] (row n-1, column 0), by
 // Sherman-Morrison: A = T + u v^T with u = (g, 0, ..., 0, sup[n-1]), v = (1, 0, ..., 0, sub[0]/g).
-Points2 solve_cyclic(const std::vector<double>& sub, std::vector<double> diag,
-                     const std::vector<double>& sup, const Points2& rhs) {
+Points2 solve_cyclic(const std::vector<double>& sub, std::vector<double> diag, const std::vector<double>& sup,
+                     const Points2& rhs) {
   const Index n = rhs.rows();
   const double g = -diag[0];
   const double alpha = sup[n - 1], beta = sub[0];
@@ -178,8 +178,7 @@ PiecewiseCubic pchip(const Points2& points, bool closed) {
         t(0, k) = t(1, k) = ch.slope(0, k);
       } else {
         t(0, k) = pchip_end_slope(ch.h(0), ch.h(1), ch.slope(0, k), ch.slope(1, k));
-        t(m - 1, k) =
-            pchip_end_slope(ch.h(p - 1), ch.h(p - 2), ch.slope(p - 1, k), ch.slope(p - 2, k));
+        t(m - 1, k) = pchip_end_slope(ch.h(p - 1), ch.h(p - 2), ch.slope(p - 1, k), ch.slope(p - 2, k));
       }
     }
   }

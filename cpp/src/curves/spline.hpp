@@ -14,12 +14,10 @@ struct PiecewiseCubic {
 
   Index pieces() const { return h.size(); }
   Vec2 position(Index i, double s) const {
-    return a.row(i).transpose() +
-           s * (b.row(i).transpose() + s * (c.row(i).transpose() + s * d.row(i).transpose()));
+    return a.row(i).transpose() + s * (b.row(i).transpose() + s * (c.row(i).transpose() + s * d.row(i).transpose()));
   }
   Vec2 derivative(Index i, double s) const {
-    return b.row(i).transpose() +
-           s * (2.0 * c.row(i).transpose() + 3.0 * s * d.row(i).transpose());
+    return b.row(i).transpose() + s * (2.0 * c.row(i).transpose() + 3.0 * s * d.row(i).transpose());
   }
 };
 

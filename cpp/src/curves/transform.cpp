@@ -34,8 +34,7 @@ Points2 checked_closed(const Points2Ref& points, const char* name) {
   int turn = 0;
   Points2 q = detail::oriented_closed_curve(points, name, turn);
   if (is_self_intersecting(q, true)) {
-    detail::invalid(name,
-                    "the closed curve intersects itself; the overlap area needs a simple curve");
+    detail::invalid(name, "the closed curve intersects itself; the overlap area needs a simple curve");
   }
   return q;
 }
@@ -157,8 +156,7 @@ Points2 Similarity2::apply_inverse(const Points2Ref& points) const {
   return out;
 }
 
-Similarity2 align_curves(const Points2Ref& c1, const Points2Ref& c2, bool closed,
-                         double tolerance) {
+Similarity2 align_curves(const Points2Ref& c1, const Points2Ref& c2, bool closed, double tolerance) {
   if (!(std::isfinite(tolerance) && tolerance > 0)) {
     detail::invalid("tolerance", "must be positive and finite, got " + std::to_string(tolerance));
   }

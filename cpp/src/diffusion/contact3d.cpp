@@ -111,7 +111,8 @@ ClearedSource clear_contact(const Points3Ref& source_vertices, const FacesRef& s
 
   for (Index f = 0; f < source_faces.rows(); ++f) {
     if (!(near[source_faces(f, 0)] && near[source_faces(f, 1)] && near[source_faces(f, 2)])) continue;
-    const Vec3 a = source_vertices.row(source_faces(f, 0)).transpose(), b = source_vertices.row(source_faces(f, 1)).transpose(),
+    const Vec3 a = source_vertices.row(source_faces(f, 0)).transpose(),
+               b = source_vertices.row(source_faces(f, 1)).transpose(),
                c = source_vertices.row(source_faces(f, 2)).transpose();
     cleared.near_area += 0.5 * (b - a).cross(c - a).norm();
   }

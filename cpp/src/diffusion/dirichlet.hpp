@@ -76,8 +76,10 @@ Eigen::MatrixXd solve_direct(Eigen::SparseMatrix<double> stiffness, const Eigen:
   std::thread worker([work] {
     try {
       Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Ordering> direct(work->matrix);
-      if (direct.info() != Eigen::Success) work->singular = true;
-      else work->x = direct.solve(work->rhs);
+      if (direct.info() != Eigen::Success)
+        work->singular = true;
+      else
+        work->x = direct.solve(work->rhs);
     } catch (...) {
       work->failure = std::current_exception();
     }
@@ -108,8 +110,8 @@ Eigen::MatrixXd solve_direct(Eigen::SparseMatrix<double> stiffness, const Eigen:
 // cores) rather than Eigen's simplicial LDL^T in its AMD order.
 template <class Elements, class Local>
 Eigen::MatrixXd solve_dirichlet_values(Index vertex_count, const Elements& elements, const std::vector<char>& fixed,
-                                       Eigen::MatrixXd values, Local local, bool iterative,
-                                       double tolerance = 1e-10, const Eigen::MatrixXd& positions = {}) {
+                                       Eigen::MatrixXd values, Local local, bool iterative, double tolerance = 1e-10,
+                                       const Eigen::MatrixXd& positions = {}) {
   std::vector<Index> unknown(vertex_count, -1);
   Index free_count = 0;
   for (Index v = 0; v < vertex_count; ++v) {
@@ -187,8 +189,8 @@ Eigen::MatrixXd solve_dirichlet_values(Index vertex_count, const Elements& eleme
 // Diffusion mapping's potential: c = 1 on the source vertices, 0 on the target (and crossing)
 // vertices, harmonic elsewhere.
 template <class Elements, class Local>
-Vector solve_dirichlet(Index vertex_count, const Elements& elements, const std::vector<char>& kind,
-                       Local local, bool iterative) {
+Vector solve_dirichlet(Index vertex_count, const Elements& elements, const std::vector<char>& kind, Local local,
+                       bool iterative) {
   std::vector<char> fixed(vertex_count);
   Eigen::MatrixXd c = Eigen::MatrixXd::Zero(vertex_count, 1);
   for (Index v = 0; v < vertex_count; ++v) {

@@ -64,7 +64,8 @@ void require_mesh(const Points& points, const Cells& cells) {
 }
 
 double signed_measure(const Points2& x, const Faces& cells, Index c) {
-  const Vec2 a = (x.row(cells(c, 1)) - x.row(cells(c, 0))).transpose(), b = (x.row(cells(c, 2)) - x.row(cells(c, 0))).transpose();
+  const Vec2 a = (x.row(cells(c, 1)) - x.row(cells(c, 0))).transpose(),
+             b = (x.row(cells(c, 2)) - x.row(cells(c, 0))).transpose();
   return 0.5 * (a.x() * b.y() - a.y() * b.x());
 }
 
@@ -135,11 +136,14 @@ Eigen::MatrixXd extension_step(const Points& x, const Cells& cells, const std::v
   constexpr double tolerance = 1e-12;
   if (options.method == ExtensionMethod::harmonic) {
     // One scalar Laplacian; each component a column of the right-hand side.
-    return detail::solve_dirichlet_values(x.rows(), cells, fixed, std::move(values), [&](Index c) {
-      Eigen::Matrix<double, corners, D> g;
-      const double measure = std::abs(simplex_gradients<D>(x, cells, c, g));
-      return Eigen::Matrix<double, corners, corners>(measure * g * g.transpose());
-    }, iterative, tolerance, Eigen::MatrixXd(x));
+    return detail::solve_dirichlet_values(
+        x.rows(), cells, fixed, std::move(values),
+        [&](Index c) {
+          Eigen::Matrix<double, corners, D> g;
+          const double measure = std::abs(simplex_gradients<D>(x, cells, c, g));
+          return Eigen::Matrix<double, corners, corners>(measure * g * g.transpose());
+        },
+        iterative, tolerance, Eigen::MatrixXd(x));
   }
   // Linear elasticity with Young's modulus 1 (it cancels with Dirichlet data only): the unknowns
   // are the components, node * D + component, coupled through the strain.
@@ -160,24 +164,27 @@ Eigen::MatrixXd extension_step(const Points& x, const Cells& cells, const std::v
       positions.row(v * D + a) = x.row(v);
     }
   }
-  flat = detail::solve_dirichlet_values(x.rows() * D, dofs, dof_fixed, std::move(flat), [&](Index c) {
-    Eigen::Matrix<double, corners, D> g;
-    const double measure = std::abs(simplex_gradients<D>(x, cells, c, g));
-    // The bilinear form 2 mu eps(u):eps(v) + lambda div u div v for u = phi_j e_b, v = phi_i e_a.
-    Eigen::Matrix<double, corners * D, corners * D> k;
-    for (int i = 0; i < corners; ++i) {
-      for (int j = 0; j < corners; ++j) {
-        const double dot = g.row(i).dot(g.row(j));
-        for (int a = 0; a < D; ++a) {
-          for (int b = 0; b < D; ++b) {
-            k(i * D + a, j * D + b) =
-                measure * (mu * (a == b ? dot : 0.0) + mu * g(i, b) * g(j, a) + lambda * g(i, a) * g(j, b));
+  flat = detail::solve_dirichlet_values(
+      x.rows() * D, dofs, dof_fixed, std::move(flat),
+      [&](Index c) {
+        Eigen::Matrix<double, corners, D> g;
+        const double measure = std::abs(simplex_gradients<D>(x, cells, c, g));
+        // The bilinear form 2 mu eps(u):eps(v) + lambda div u div v for u = phi_j e_b, v = phi_i e_a.
+        Eigen::Matrix<double, corners * D, corners * D> k;
+        for (int i = 0; i < corners; ++i) {
+          for (int j = 0; j < corners; ++j) {
+            const double dot = g.row(i).dot(g.row(j));
+            for (int a = 0; a < D; ++a) {
+              for (int b = 0; b < D; ++b) {
+                k(i * D + a, j * D + b) =
+                    measure * (mu * (a == b ? dot : 0.0) + mu * g(i, b) * g(j, a) + lambda * g(i, a) * g(j, b));
+              }
+            }
           }
         }
-      }
-    }
-    return k;
-  }, iterative, tolerance, positions);
+        return k;
+      },
+      iterative, tolerance, positions);
   for (Index v = 0; v < x.rows(); ++v) {
     for (int a = 0; a < D; ++a) values(v, a) = flat(v * D + a, 0);
   }
@@ -278,8 +285,8 @@ InteriorField3 extend_field(const DisplacementField3& field, const Points3Ref& m
   require_options(options);
   InteriorField3 out;
   if (mesh_cells.rows() == 0) {
-    const detail::VolumeMesh mesh = detail::mesh_volume(field.starts, field.faces, default_size(field, options),
-                                                        options.seed, "field");
+    const detail::VolumeMesh mesh =
+        detail::mesh_volume(field.starts, field.faces, default_size(field, options), options.seed, "field");
     out.points = mesh.vertices;
     out.cells = mesh.tetrahedra;
   } else {

@@ -12,9 +12,9 @@
 #include "diffusion/dirichlet.hpp"
 #include "diffusion/region_mesh.hpp"
 
+#include <tbb/parallel_for.h>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
@@ -37,11 +37,14 @@ double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(
 
 // The P1 solution on the triangles: local stiffness grad phi_i . grad phi_j * area.
 Vector solve_potential(const detail::RegionMesh& mesh, const std::vector<char>& kind) {
-  return detail::solve_dirichlet(mesh.vertices.rows(), mesh.triangles, kind, [&](Index t) {
-    Vec2 p[3];
-    for (int i = 0; i < 3; ++i) p[i] = mesh.vertices.row(mesh.triangles(t, i)).transpose();
-    return detail::triangle_stiffness(p);
-  }, false);
+  return detail::solve_dirichlet(
+      mesh.vertices.rows(), mesh.triangles, kind,
+      [&](Index t) {
+        Vec2 p[3];
+        for (int i = 0; i < 3; ++i) p[i] = mesh.vertices.row(mesh.triangles(t, i)).transpose();
+        return detail::triangle_stiffness(p);
+      },
+      false);
 }
 
 // Follows -grad c from a vertex of the source until it meets the target. The P1 gradient is
@@ -53,7 +56,11 @@ Vector solve_potential(const detail::RegionMesh& mesh, const std::vector<char>& 
 class Tracer {
  public:
   Tracer(const detail::RegionMesh& mesh, const Vector& c, const std::vector<char>& kind)
-      : mesh_(mesh), c_(c), kind_(kind), step_(mesh.triangles.rows()), to_barycentric_(mesh.triangles.rows()),
+      : mesh_(mesh),
+        c_(c),
+        kind_(kind),
+        step_(mesh.triangles.rows()),
+        to_barycentric_(mesh.triangles.rows()),
         flow_(mesh.triangles.rows()) {
     const Index n = mesh.vertices.rows(), triangles = mesh.triangles.rows();
     offsets_.assign(n + 1, 0);
@@ -171,8 +178,8 @@ class Tracer {
         vertex = -1;
       }
       const double h = step_[t];
-      const Vec2 k1 = direction(t, x), k2 = direction(t, x + 0.5 * h * k1),
-                 k3 = direction(t, x + 0.5 * h * k2), k4 = direction(t, x + h * k3);
+      const Vec2 k1 = direction(t, x), k2 = direction(t, x + 0.5 * h * k1), k3 = direction(t, x + 0.5 * h * k2),
+                 k4 = direction(t, x + h * k3);
       if (k1.squaredNorm() == 0.0) {  // no flow here: continue from the lowest corner
         vertex = lowest_corner(t);
         if (c_[vertex] >= c_at(t, x)) return lost;
@@ -315,18 +322,20 @@ class Tracer {
 
 }  // namespace
 
-DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2Ref& target_points,
-                                  bool closed, const DiffusionOptions& options) {
+DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2Ref& target_points, bool closed,
+                                  const DiffusionOptions& options) {
   const Index ns = detail::require_curve(source_points, closed, "c1");
   const Index nt = detail::require_curve(target_points, closed, "c2");
   // Meshing squares lengths: keep them far from overflow and underflow.
-  for (const auto& [points, rows, name] : {std::tuple(&source_points, ns, "c1"), std::tuple(&target_points, nt, "c2")}) {
+  for (const auto& [points, rows, name] :
+       {std::tuple(&source_points, ns, "c1"), std::tuple(&target_points, nt, "c2")}) {
     const auto p = points->topRows(rows);
     const double far = p.cwiseAbs().maxCoeff();
     const double extent = (p.colwise().maxCoeff() - p.colwise().minCoeff()).norm();
     if (!(far <= 1e100) || !(extent >= 1e-100)) {
-      detail::invalid(name, "diffusion mapping needs coordinates within 1e100 of the origin and a curve "
-                            "wider than 1e-100 (rescale the curves)");
+      detail::invalid(name,
+                      "diffusion mapping needs coordinates within 1e100 of the origin and a curve "
+                      "wider than 1e-100 (rescale the curves)");
     }
   }
   // The region between the curves is only defined for simple ones.
@@ -344,7 +353,8 @@ DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2
   bool crossing = false;
   if (closed) {
     crossing = curve_intersections(source, target, true).points.rows() > 0;
-    if (!crossing && !detail::inside(source.row(0).transpose(), target) && !detail::inside(target.row(0).transpose(), source)) {
+    if (!crossing && !detail::inside(source.row(0).transpose(), target) &&
+        !detail::inside(target.row(0).transpose(), source)) {
       detail::invalid("c2", "diffusion mapping needs one curve inside the other, or crossing curves");
     }
     loops = {source, target};
@@ -417,8 +427,10 @@ DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2
   const Vector to_target = on_target.closest_points(added_points).distances;
   for (std::size_t k = 0; k < added.size(); ++k) {
     const Index row = static_cast<Index>(k);
-    if (to_target[row] <= tolerance) kind[added[k]] = target_vertex;
-    else if (to_source[row] <= tolerance) kind[added[k]] = source_vertex;
+    if (to_target[row] <= tolerance)
+      kind[added[k]] = target_vertex;
+    else if (to_source[row] <= tolerance)
+      kind[added[k]] = source_vertex;
   }
 
   solution.potential = solve_potential(mesh, kind);
@@ -434,7 +446,8 @@ DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2
     if (start < 0 || kind[start] == target_vertex) unstarted.push_back(i);
   }
   Points2 unstarted_points(static_cast<Index>(unstarted.size()), 2);
-  for (std::size_t k = 0; k < unstarted.size(); ++k) unstarted_points.row(static_cast<Index>(k)) = source.row(unstarted[k]);
+  for (std::size_t k = 0; k < unstarted.size(); ++k)
+    unstarted_points.row(static_cast<Index>(k)) = source.row(unstarted[k]);
   const Vector unstarted_to_target = on_target.closest_points(unstarted_points).distances;
   std::vector<char> on_target_already(ns, 0);
   for (std::size_t k = 0; k < unstarted.size(); ++k) {

@@ -11,10 +11,10 @@
 #include "common/interrupt_check.hpp"
 #include "diffusion/nested_dissection.hpp"
 
+#include <tbb/parallel_for.h>
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <atomic>

@@ -11,10 +11,10 @@
 #include <CGAL/Delaunay_mesh_size_criteria_2.h>
 #include <CGAL/Delaunay_mesher_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Spatial_sort_traits_adapter_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 #include <CGAL/property_map.h>
 #include <CGAL/spatial_sort.h>
-#include <CGAL/Spatial_sort_traits_adapter_2.h>
 
 #include <algorithm>
 #include <cmath>
@@ -58,7 +58,9 @@ class Criteria : public CGAL::Delaunay_mesh_size_criteria_2<Cdt> {
 
  public:
   Criteria(double aspect_bound, double size_bound, double lattice_bound)
-      : CGAL::Delaunay_mesh_criteria_2<Cdt>(aspect_bound), Base(aspect_bound, size_bound), lattice_bound_(lattice_bound) {}
+      : CGAL::Delaunay_mesh_criteria_2<Cdt>(aspect_bound),
+        Base(aspect_bound, size_bound),
+        lattice_bound_(lattice_bound) {}
 
   class Is_bad : public Base::Is_bad {
    public:
@@ -141,7 +143,6 @@ void mark_odd_nesting(Cdt& cdt) {
   }
 }
 
-
 // The points (x, y pairs) that lie at least away[k] from every loop.
 std::vector<Point> clear_of_loops(const std::vector<CurveIndex>& loops, const std::vector<double>& xy,
                                   const std::vector<double>& away) {
@@ -168,7 +169,8 @@ std::vector<Point> lattice_points(const std::vector<Points2>& loops, const std::
                                   double edge, double clearance) {
   const double row = edge * std::sqrt(3.0) / 2.0;
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (const Points2& loop : loops) lo = std::min(lo, loop.col(1).minCoeff()), hi = std::max(hi, loop.col(1).maxCoeff());
+  for (const Points2& loop : loops)
+    lo = std::min(lo, loop.col(1).minCoeff()), hi = std::max(hi, loop.col(1).maxCoeff());
   const double first_row = std::ceil(lo / row), rows = std::floor(hi / row) - first_row + 1.0;
   if (!(rows <= static_cast<double>(kMaxVertices))) too_many_vertices();
   // Where each row crosses the loops; an edge holds the rows in [its lower y, its upper y).
@@ -328,8 +330,8 @@ RegionMesh mesh_region(const std::vector<Points2>& loops, double max_edge) {
     }
     mark_odd_nesting(cdt);
     // Refine step by step so that a degenerate input cannot run away with time and memory.
-    CGAL::Delaunay_mesher_2<Cdt, Criteria> mesher(cdt, Criteria(0.125, max_edge > 0 ? max_edge : 0.0,
-                                                                 2.0 / std::sqrt(3.0) * kLattice * max_edge * 1.001));
+    CGAL::Delaunay_mesher_2<Cdt, Criteria> mesher(
+        cdt, Criteria(0.125, max_edge > 0 ? max_edge : 0.0, 2.0 / std::sqrt(3.0) * kLattice * max_edge * 1.001));
     mesher.init(true);
     while (mesher.try_one_step_refine_mesh()) {
       if (cdt.number_of_vertices() > kMaxVertices) too_many_vertices();

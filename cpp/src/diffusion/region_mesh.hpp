@@ -8,12 +8,12 @@ namespace morphomap::detail {
 
 struct RegionMesh {
   Points2 vertices;
-  Faces triangles;           // counter-clockwise
-  Faces neighbours;              // neighbours(t, i): the triangle across the edge opposite
-                                 // vertex i of t, or -1 on the region's boundary
-  std::vector<Index> input;      // for each mesh vertex, its input point (loops concatenated), or -1
-  std::vector<Index> of_input;   // for each input point, its mesh vertex
-  std::vector<char> on_boundary; // mesh vertex on a constrained (boundary) edge
+  Faces triangles;                // counter-clockwise
+  Faces neighbours;               // neighbours(t, i): the triangle across the edge opposite
+                                  // vertex i of t, or -1 on the region's boundary
+  std::vector<Index> input;       // for each mesh vertex, its input point (loops concatenated), or -1
+  std::vector<Index> of_input;    // for each input point, its mesh vertex
+  std::vector<char> on_boundary;  // mesh vertex on a constrained (boundary) edge
 };
 
 // The region is the set of points inside an odd number of the loops (an annulus for two nested

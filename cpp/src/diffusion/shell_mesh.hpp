@@ -35,17 +35,16 @@ enum FacePatch : signed char { interior_face = 0, source_face = 1, target_face =
 
 struct ShellMesh {
   Points3 vertices;
-  Tetrahedra tetrahedra;         // positively oriented
-  Tetrahedra neighbours;         // neighbours(t, i): the tetrahedron across the face opposite
-                                 // vertex i of t, or -1 on the boundary
+  Tetrahedra tetrahedra;  // positively oriented
+  Tetrahedra neighbours;  // neighbours(t, i): the tetrahedron across the face opposite
+                          // vertex i of t, or -1 on the boundary
   Eigen::Matrix<signed char, Eigen::Dynamic, 4, Eigen::RowMajor> patches;  // FacePatch of each face
 };
 
 // Both surfaces closed, consistently oriented outwards (positive volume) and not crossing; inner
 // and outer as classify_nesting found them. Throws GeometryError if Mesh_3 fails.
-ShellMesh mesh_shell(const Points3Ref& source_vertices, const FacesRef& source_faces,
-                     const Points3Ref& target_vertices, const FacesRef& target_faces, bool source_inside,
-                     const ShellMeshCriteria& criteria);
+ShellMesh mesh_shell(const Points3Ref& source_vertices, const FacesRef& source_faces, const Points3Ref& target_vertices,
+                     const FacesRef& target_faces, bool source_inside, const ShellMeshCriteria& criteria);
 
 // The symmetric difference of two crossing closed surfaces: each surface cut along the curves
 // where they cross (CGAL's corefinement) into patches that lie inside or outside the other. The
@@ -54,8 +53,8 @@ class CrossingRegion {
  public:
   // Both surfaces closed, consistently oriented outwards, free of self-intersections and crossing
   // (classify_nesting). Throws InvalidInput if the two coincide over a patch.
-  CrossingRegion(const Points3Ref& source_vertices, const FacesRef& source_faces,
-                 const Points3Ref& target_vertices, const FacesRef& target_faces);
+  CrossingRegion(const Points3Ref& source_vertices, const FacesRef& source_faces, const Points3Ref& target_vertices,
+                 const FacesRef& target_faces);
   ~CrossingRegion();
   CrossingRegion(const CrossingRegion&) = delete;
   CrossingRegion& operator=(const CrossingRegion&) = delete;

@@ -91,8 +91,7 @@ bool improve_node(const Points& rest, Points& moved, const Cells& cells, const s
 }
 
 template <class Points, class Cells>
-Index untangle_mesh(const Points& rest, Points& moved, const Cells& cells, const std::vector<char>& fixed,
-                    int sweeps) {
+Index untangle_mesh(const Points& rest, Points& moved, const Cells& cells, const std::vector<char>& fixed, int sweeps) {
   std::vector<std::vector<Index>> stars(rest.rows());  // the cells of each node
   for (Index c = 0; c < cells.rows(); ++c) {
     for (Index i = 0; i < cells.cols(); ++i) stars[cells(c, i)].push_back(c);

@@ -19,7 +19,6 @@ using detail::kNaN;
 
 namespace {
 
-
 template <class Rows>
 void require_finite_rows(const Rows& points, const char* name) {
   for (Index i = 0; i < points.rows(); ++i) {
@@ -94,7 +93,8 @@ DisplacementAt2 displacement_at(const DisplacementField2& field, const Points2Re
 DisplacementAt3 displacement_at(const DisplacementField3& field, const Points3Ref& points) {
   require_finite_rows(points, "points");
   if (field.ends.rows() != field.starts.rows()) detail::invalid("field", "starts and ends differ in length");
-  if (field.faces.rows() == 0) detail::invalid("field", "has no faces: a 3D field needs the triangles of its start points");
+  if (field.faces.rows() == 0)
+    detail::invalid("field", "has no faces: a 3D field needs the triangles of its start points");
   // The start triangles whose corners all have a start point, over the vertices they use.
   std::vector<Index> vertex_of(field.size(), -1), used;
   std::vector<Index> kept;
@@ -102,7 +102,8 @@ DisplacementAt3 displacement_at(const DisplacementField3& field, const Points3Re
     bool finite = true;
     for (int c = 0; c < 3; ++c) {
       const Index v = field.faces(f, c);
-      if (v < 0 || v >= field.size()) detail::invalid("field", "face " + std::to_string(f) + " refers to a missing vector");
+      if (v < 0 || v >= field.size())
+        detail::invalid("field", "face " + std::to_string(f) + " refers to a missing vector");
       finite = finite && field.starts.row(v).allFinite();
     }
     if (finite) kept.push_back(f);
@@ -127,8 +128,7 @@ DisplacementAt3 displacement_at(const DisplacementField3& field, const Points3Re
     if (f < 0) continue;
     // Barycentric weights of the projection in its triangle.
     const Eigen::Vector3d p0 = vertices.row(faces(f, 0)), e1 = vertices.row(faces(f, 1)).transpose() - p0,
-                          e2 = vertices.row(faces(f, 2)).transpose() - p0,
-                          d = hits.points.row(q).transpose() - p0;
+                          e2 = vertices.row(faces(f, 2)).transpose() - p0, d = hits.points.row(q).transpose() - p0;
     const double g11 = e1.dot(e1), g12 = e1.dot(e2), g22 = e2.dot(e2), r1 = d.dot(e1), r2 = d.dot(e2);
     const double det = g11 * g22 - g12 * g12;
     double w1 = det > 0 ? (g22 * r1 - g12 * r2) / det : 0.0, w2 = det > 0 ? (g11 * r2 - g12 * r1) / det : 0.0;

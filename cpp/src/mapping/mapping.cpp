@@ -1,8 +1,8 @@
 // The paper's 2D mapping: basic algorithms (minimal distance, normal, uniform) on a source curve
 // and a target curve, or on each pair of segments between their intersection points (split), with
 // the reverse and transform extensions around them.
-#include <morphomap/curve_geometry.hpp>
 #include <morphomap/crossings.hpp>
+#include <morphomap/curve_geometry.hpp>
 #include <morphomap/curve_queries.hpp>
 #include <morphomap/laplace.hpp>
 #include <morphomap/mapping.hpp>
@@ -35,25 +35,38 @@ using detail::kNaN;
 
 std::string method_name(Method method) {
   switch (method) {
-    case Method::minimal_distance: return "minimal_distance";
-    case Method::normal: return "normal";
-    case Method::diffusion: return "diffusion";
-    case Method::uniform: return "uniform";
-    case Method::reverse_minimal_distance: return "reverse_minimal_distance";
-    case Method::reverse_normal: return "reverse_normal";
-    case Method::reverse_diffusion: return "reverse_diffusion";
-    case Method::reverse_uniform: return "reverse_uniform";
-    case Method::optimal: return "optimal";
-    case Method::reverse_optimal: return "reverse_optimal";
+    case Method::minimal_distance:
+      return "minimal_distance";
+    case Method::normal:
+      return "normal";
+    case Method::diffusion:
+      return "diffusion";
+    case Method::uniform:
+      return "uniform";
+    case Method::reverse_minimal_distance:
+      return "reverse_minimal_distance";
+    case Method::reverse_normal:
+      return "reverse_normal";
+    case Method::reverse_diffusion:
+      return "reverse_diffusion";
+    case Method::reverse_uniform:
+      return "reverse_uniform";
+    case Method::optimal:
+      return "optimal";
+    case Method::reverse_optimal:
+      return "reverse_optimal";
   }
   return "unknown";
 }
 
 Method reversed(Method method) {
   switch (method) {
-    case Method::optimal: return Method::reverse_optimal;
-    case Method::reverse_optimal: return Method::optimal;
-    default: break;
+    case Method::optimal:
+      return Method::reverse_optimal;
+    case Method::reverse_optimal:
+      return Method::optimal;
+    default:
+      break;
   }
   const int code = static_cast<int>(method);
   return static_cast<Method>(code < 4 ? code + 4 : code - 4);
@@ -67,18 +80,18 @@ using detail::Meeting;
 // A piece of the source (the whole curve, or the stretch between two crossings) with its start
 // points, and the piece of the target it maps onto.
 struct Job {
-  Points2 source;                // the source polyline
+  Points2 source;  // the source polyline
   bool source_closed = false;
   std::vector<Index> start_rows;  // rows of source that are start points, in order along it
-  Points2 normals;               // normal mapping: the normal of the whole curve at each start
-  Vector fractions;              // uniform: arc position along the source / its length
+  Points2 normals;                // normal mapping: the normal of the whole curve at each start
+  Vector fractions;               // uniform: arc position along the source / its length
   Points2 target;
   bool target_closed = false;
   // The first / last rows of source and target are the two ends of a meeting (a crossing or a
   // contact stretch), whose own vectors map them: no start point there, either way round.
   bool shared_begin = false, shared_end = false;
-  double anchor = 0.0;           // uniform: target arc position where fraction 0 lands
-  int direction = 1;             // uniform: +1 forward along the target, -1 backward
+  double anchor = 0.0;  // uniform: target arc position where fraction 0 lands
+  int direction = 1;    // uniform: +1 forward along the target, -1 backward
   // The query indexes of source and target, built on first use and shared by every attempt on
   // the job (Algorithm 1 may try four) and by its reverse.
   mutable std::shared_ptr<const CurveIndex> source_index, target_index;
@@ -88,7 +101,6 @@ const CurveIndex& target_index(const Job& job) {
   if (!job.target_index) job.target_index = std::make_shared<const CurveIndex>(job.target, job.target_closed);
   return *job.target_index;
 }
-
 
 // Vectors with the arc position of their start along the whole source curve, to order them.
 struct Vectors {
@@ -199,8 +211,8 @@ Points2 optimal_ends(const Job& job, double stretch_weight) {
   if (!job.source_closed) return monotone_match(job.source, job.start_rows, job.target, stretch_weight).points;
   const ArcCurve source(job.source, true, "c1");
   const ArcCurve given(job.target, true, "c2");
-  const ArcCurve target(relative_direction(source, given) > 0 ? given.points() : Points2(given.points().colwise().reverse()),
-                        true, "c2");
+  const ArcCurve target(
+      relative_direction(source, given) > 0 ? given.points() : Points2(given.points().colwise().reverse()), true, "c2");
   const Index n = source.size();
   const Index count = static_cast<Index>(job.start_rows.size());
   auto pass = [&](Index first, double anchor, MonotoneMatch& match) {
@@ -259,12 +271,18 @@ Points2 basic_ends(MapMethod method, const Job& job, const Points2& starts, cons
 
 Method basic_method(MapMethod method) {
   switch (method) {
-    case MapMethod::minimal_distance: return Method::minimal_distance;
-    case MapMethod::optimal: return Method::optimal;
-    case MapMethod::normal: return Method::normal;
-    case MapMethod::uniform: return Method::uniform;
-    case MapMethod::diffusion: return Method::diffusion;
-    case MapMethod::automatic: break;
+    case MapMethod::minimal_distance:
+      return Method::minimal_distance;
+    case MapMethod::optimal:
+      return Method::optimal;
+    case MapMethod::normal:
+      return Method::normal;
+    case MapMethod::uniform:
+      return Method::uniform;
+    case MapMethod::diffusion:
+      return Method::diffusion;
+    case MapMethod::automatic:
+      break;
   }
   detail::invalid("method", "'auto' is not a basic algorithm");
 }
@@ -301,8 +319,9 @@ Vectors reverse(MapMethod method, const Job& job, const ArcCurve& whole_source, 
   const Index n = job.target.rows();
   for (Index i = 0; i < n; ++i) {
     const bool shared =
-        !job.target_closed && ((i == 0 && (job.shared_begin || job.target.row(0) == job.source.row(0))) ||
-                               (i == n - 1 && (job.shared_end || job.target.row(n - 1) == job.source.row(job.source.rows() - 1))));
+        !job.target_closed &&
+        ((i == 0 && (job.shared_begin || job.target.row(0) == job.source.row(0))) ||
+         (i == n - 1 && (job.shared_end || job.target.row(n - 1) == job.source.row(job.source.rows() - 1))));
     if (!shared) back.start_rows.push_back(i);
   }
   Vectors v;
@@ -334,15 +353,15 @@ bool complete(const Vectors& v) { return v.starts.allFinite() && v.ends.allFinit
 // diffusion fails on a piece (its mesh cannot be made, streamlines stall), "auto" still answers:
 // forward diffusion, which is crossing-free too; then the first attempt if it missed nothing
 // (crossings and all); then minimal distance, which always finds a point.
-Vectors run(MapMethod method, const Job& job, const std::vector<double>& start_keys,
-            const ArcCurve& whole_source, const CurveIndex& whole_source_index, const Settings& settings) {
+Vectors run(MapMethod method, const Job& job, const std::vector<double>& start_keys, const ArcCurve& whole_source,
+            const CurveIndex& whole_source_index, const Settings& settings) {
   detail::check_interrupt();
   if (method != MapMethod::automatic) return forward(method, job, start_keys, settings);
   if (job.start_rows.empty()) return forward(MapMethod::normal, job, start_keys, settings);
-  const Vectors first = settings.density_threshold > 0.0 &&
-                                point_density(job, start_points(job)) > settings.density_threshold
-                            ? reverse(MapMethod::minimal_distance, job, whole_source, whole_source_index, settings)
-                            : forward(MapMethod::normal, job, start_keys, settings);
+  const Vectors first =
+      settings.density_threshold > 0.0 && point_density(job, start_points(job)) > settings.density_threshold
+          ? reverse(MapMethod::minimal_distance, job, whole_source, whole_source_index, settings)
+          : forward(MapMethod::normal, job, start_keys, settings);
   if (complete(first) && count_crossings(first.starts, first.ends) == 0) return first;
   for (const bool backwards : {true, false}) {
     try {
@@ -475,8 +494,9 @@ Split split_pair(const ArcCurve& source, const ArcCurve& target, bool closed, bo
     }
   } else {
     const Index last = n - 1;
-    out.pieces.emplace_back(End{0.0, 0.0, source.points().row(0).transpose(), target.points().row(0).transpose(), false},
-                            begin_of(meetings[0], 0.0));
+    out.pieces.emplace_back(
+        End{0.0, 0.0, source.points().row(0).transpose(), target.points().row(0).transpose(), false},
+        begin_of(meetings[0], 0.0));
     for (Index p = 0; p + 1 < count; ++p) out.pieces.emplace_back(end_of(meetings[p]), begin_of(meetings[p + 1], 0.0));
     out.pieces.emplace_back(end_of(meetings[count - 1]),
                             End{source.length(), target.length(), source.points().row(last).transpose(),
@@ -537,9 +557,8 @@ std::pair<Points2, Points2> piece_polylines(const ArcCurve& source, const ArcCur
   return {std::move(piece_source), std::move(piece_target)};
 }
 
-Vectors map_directed(const Points2& source_points, const Points2& target_points, MapMethod method,
-                     bool closed, bool split, const std::optional<std::pair<Vec2, Vec2>>& anchors,
-                     const Settings& settings) {
+Vectors map_directed(const Points2& source_points, const Points2& target_points, MapMethod method, bool closed,
+                     bool split, const std::optional<std::pair<Vec2, Vec2>>& anchors, const Settings& settings) {
   const ArcCurve source(source_points, closed, "c1");
   const ArcCurve target(target_points, closed, "c2");
   const auto whole_source_index = std::make_shared<const CurveIndex>(source.points(), closed);
@@ -662,14 +681,13 @@ void project_onto(Points2& points, const Points2Ref& curve, bool closed) {
 
 }  // namespace
 
-DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2,
-                              const CurveMappingOptions& options) {
+DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2, const CurveMappingOptions& options) {
   const bool closed = options.closed;
   const Index n1 = detail::require_simple_curve(c1, closed, "c1");
   const Index n2 = detail::require_simple_curve(c2, closed, "c2");
   if (options.n < 0 || (options.n > 0 && options.n < (closed ? 3 : 2))) {
-    detail::invalid("n", "must be 0 (use the given points) or at least " +
-                              std::string(closed ? "3" : "2") + ", got " + std::to_string(options.n));
+    detail::invalid("n", "must be 0 (use the given points) or at least " + std::string(closed ? "3" : "2") + ", got " +
+                             std::to_string(options.n));
   }
   if (!(options.density_threshold >= 0.0) || !std::isfinite(options.density_threshold)) {
     detail::invalid("density_threshold", "must be a finite number >= 0 (0: off)");
@@ -678,6 +696,7 @@ DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2,
     detail::invalid("contact_tolerance", "must be a finite length >= 0, or negative for the default");
   }
   detail::require_diffusion_options(options.diffusion);
+  if (options.anchor && !options.anchor->allFinite()) detail::invalid("anchor", "has a non-finite coordinate");
   // Frames of one organ overlap; closed curves that neither cross nor nest are the wrong pair
   // (other units, another offset), whatever a method would make of them.
   // (Each curve's point farthest from the other decides: a touching point would not.)
@@ -689,8 +708,9 @@ DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2,
   if (closed && curve_intersections(c1.topRows(n1), c2.topRows(n2), true).points.rows() == 0 &&
       !detail::inside(farthest(c1.topRows(n1), c2.topRows(n2)), c2.topRows(n2)) &&
       !detail::inside(farthest(c2.topRows(n2), c1.topRows(n1)), c1.topRows(n1))) {
-    detail::invalid("c2", "lies apart from c1 (the curves neither cross nor enclose one another): consecutive "
-                          "frames of one organ overlap; check their units and offsets");
+    detail::invalid("c2",
+                    "lies apart from c1 (the curves neither cross nor enclose one another): consecutive "
+                    "frames of one organ overlap; check their units and offsets");
   }
   Points2 a = options.n > 0 ? resample(c1, options.n, closed) : Points2(c1.topRows(n1));
   const Points2 b = options.n > 0 ? resample(c2, options.n, closed) : Points2(c2.topRows(n2));
@@ -702,7 +722,6 @@ DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2,
   }
   std::optional<std::pair<Vec2, Vec2>> anchors;
   if (options.anchor) {
-    if (!options.anchor->allFinite()) detail::invalid("anchor", "has a non-finite coordinate");
     Points2 anchor = options.anchor->transpose();
     if (options.transform) anchor = similarity.apply(anchor);
     const Vec2 on_c1 = closest_points(anchor, a, closed).points.row(0).transpose();
@@ -734,8 +753,7 @@ DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2,
   return field;
 }
 
-CurveSplit split_curves(const Points2Ref& c1, const Points2Ref& c2, bool closed, bool split,
-                        double contact_tolerance) {
+CurveSplit split_curves(const Points2Ref& c1, const Points2Ref& c2, bool closed, bool split, double contact_tolerance) {
   const Index n1 = detail::require_simple_curve(c1, closed, "c1");
   const Index n2 = detail::require_simple_curve(c2, closed, "c2");
   if (std::isnan(contact_tolerance) || std::isinf(contact_tolerance)) {
@@ -763,7 +781,9 @@ CurveSplit split_curves(const Points2Ref& c1, const Points2Ref& c2, bool closed,
     piece.begin_meeting = from.meeting, piece.end_meeting = to.meeting;
     piece.source_begin = source.wrap(from.s), piece.source_length = to.s - from.s;
     piece.target_begin = target.wrap(from.t);
-    piece.target_length = !closed ? to.t - from.t : direction > 0 ? target.forward(from.t, to.t) : target.forward(to.t, from.t);
+    piece.target_length = !closed         ? to.t - from.t
+                          : direction > 0 ? target.forward(from.t, to.t)
+                                          : target.forward(to.t, from.t);
     out.pieces.push_back(std::move(piece));
   }
   return out;

@@ -107,8 +107,8 @@ bool solve_level(const Problem& p, const Level& level, std::vector<Index>& path,
   // Whether the vector p -> end crosses one of the kRecent vectors before it on the best path
   // into (r - 1, kp): its neighbour exactly, the ones further back as that path has them (the
   // DP's state holds one vector; staircase contours cross two or three apart).
-  auto crosses_recent = [&](const Level& lv, const std::vector<std::vector<std::int32_t>>& from_row, Index r,
-                            Index kp, const Vec2& point, const Vec2& end) {
+  auto crosses_recent = [&](const Level& lv, const std::vector<std::vector<std::int32_t>>& from_row, Index r, Index kp,
+                            const Vec2& point, const Vec2& end) {
     Index k_back = kp;
     for (Index d = 1; d <= kRecent && r - d >= 0; ++d) {
       if (d > 1) {
@@ -135,7 +135,8 @@ bool solve_level(const Problem& p, const Level& level, std::vector<Index>& path,
     // A long source edge (curves are not resampled by default) may take as long a target arc.
     const Index row_reach =
         p.source_length > 0.0
-            ? std::max(reach, static_cast<Index>(std::ceil(8.0 * static_cast<double>(samples) * dl / p.source_length)) + 2)
+            ? std::max(reach,
+                       static_cast<Index>(std::ceil(8.0 * static_cast<double>(samples) * dl / p.source_length)) + 2)
             : reach;
     for (Index k = lo; k <= hi; ++k) {
       const double displacement = p.displacement_weight * (pi - q[k]).squaredNorm();
@@ -199,8 +200,8 @@ std::vector<double> carry(const Problem& p, const std::vector<Index>& coarse_row
 
 }  // namespace
 
-MonotoneMatch monotone_match(const Points2Ref& source, const std::vector<Index>& start_rows,
-                             const Points2Ref& target, double stretch_weight) {
+MonotoneMatch monotone_match(const Points2Ref& source, const std::vector<Index>& start_rows, const Points2Ref& target,
+                             double stretch_weight) {
   if (!(stretch_weight >= 0.0) || !std::isfinite(stretch_weight)) {
     detail::invalid("stretch_weight", "must be a finite number >= 0, got " + std::to_string(stretch_weight));
   }
@@ -222,7 +223,8 @@ MonotoneMatch monotone_match(const Points2Ref& source, const std::vector<Index>&
   // Arc positions along both open polylines (repeated points kept: the pieces may touch).
   Vector source_arc(source.rows());
   source_arc[0] = 0.0;
-  for (Index i = 1; i < source.rows(); ++i) source_arc[i] = source_arc[i - 1] + (source.row(i) - source.row(i - 1)).norm();
+  for (Index i = 1; i < source.rows(); ++i)
+    source_arc[i] = source_arc[i - 1] + (source.row(i) - source.row(i - 1)).norm();
   double target_length = 0.0;
   for (Index i = 1; i < target.rows(); ++i) target_length += (target.row(i) - target.row(i - 1)).norm();
   if (!(target_length > 0.0)) {  // a target piece shrunk to a point takes every start
@@ -272,7 +274,8 @@ MonotoneMatch monotone_match(const Points2Ref& source, const std::vector<Index>&
     const Index count = static_cast<Index>(level.rows.size());
     level.samples = std::max(4 * (count + 1), (finest * (count + 1) + n) / (n + 1));
     const double per_sample = p.target_length / static_cast<double>(level.samples);
-    const std::vector<double> centre = coarse_rows.empty() ? std::vector<double>() : carry(p, coarse_rows, coarse_t, level.rows);
+    const std::vector<double> centre =
+        coarse_rows.empty() ? std::vector<double>() : carry(p, coarse_rows, coarse_t, level.rows);
     Index band = std::max<Index>(16, 8 * level.samples / (count + 1));
     std::vector<Index> path;
     for (;;) {

@@ -25,7 +25,6 @@ using detail::kNaN;
 
 namespace {
 
-
 struct Surface {
   Points3Ref vertices;
   FacesRef faces;
@@ -56,7 +55,8 @@ DisplacementField3 basic(MapMethod method, const Surface& source, const Surface&
       options.mesh_size = mesh_size;
       const ShellDiffusionSolution solution =
           solve_diffusion_3d(source.vertices, source.faces, target.vertices, target.faces, options);
-      if (solution.ends.rows() != field.size()) throw GeometryError("diffusion: the solver returned the wrong number of ends");
+      if (solution.ends.rows() != field.size())
+        throw GeometryError("diffusion: the solver returned the wrong number of ends");
       // The tetrahedral mesh only approximates the target: put each end onto the target itself.
       field.ends = solution.ends;
       const std::vector<Index> rows = detail::finite_rows(field.ends);
@@ -82,7 +82,8 @@ DisplacementField3 basic(MapMethod method, const Surface& source, const Surface&
       break;
     }
     default:
-      detail::invalid("method", "uniform mapping has no 3D form; use 'minimal_distance', 'normal', 'diffusion' or 'auto'");
+      detail::invalid("method",
+                      "uniform mapping has no 3D form; use 'minimal_distance', 'normal', 'diffusion' or 'auto'");
   }
   return field;
 }
@@ -145,11 +146,13 @@ DisplacementField3 map_surfaces(const Points3Ref& v1, const FacesRef& f1, const 
   // Both surfaces free of self-intersections (classify_nesting checks), and overlapping: frames
   // of one organ do (see map_curves).
   if (detail::classify_nesting(v1, f1, v2, f2) == detail::Nesting::disjoint) {
-    detail::invalid("s2", "lies apart from s1 (the surfaces neither cross nor enclose one another): consecutive "
-                          "frames of one organ overlap; check their units and offsets");
+    detail::invalid("s2",
+                    "lies apart from s1 (the surfaces neither cross nor enclose one another): consecutive "
+                    "frames of one organ overlap; check their units and offsets");
   }
   if (options.method == MapMethod::uniform) {
-    detail::invalid("method", "uniform mapping has no 3D form; use 'minimal_distance', 'normal', 'diffusion' or 'auto'");
+    detail::invalid("method",
+                    "uniform mapping has no 3D form; use 'minimal_distance', 'normal', 'diffusion' or 'auto'");
   }
   if (!(options.diffusion_mesh_size >= 0) || !std::isfinite(options.diffusion_mesh_size)) {
     detail::invalid("mesh_size", "must be a finite number >= 0");

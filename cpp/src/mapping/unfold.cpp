@@ -101,9 +101,8 @@ V3 into_kernel(Index v, const std::vector<Index>& around, const FacesRef& faces,
 
 }  // namespace
 
-Index unfold(const Points3Ref& starts, Points3& ends, const FacesRef& faces, const Points3Ref& v1,
-             const FacesRef& f1, const SurfaceIndex& index1, const Points3Ref& v2, const FacesRef& f2,
-             const SurfaceIndex& index2) {
+Index unfold(const Points3Ref& starts, Points3& ends, const FacesRef& faces, const Points3Ref& v1, const FacesRef& f1,
+             const SurfaceIndex& index1, const Points3Ref& v2, const FacesRef& f2, const SurfaceIndex& index2) {
   std::vector<char> folded = folded_faces(starts, ends, faces, v1, f1, index1, v2, f2, index2);
   Index left = static_cast<Index>(std::count(folded.begin(), folded.end(), 1));
   if (left == 0) return 0;

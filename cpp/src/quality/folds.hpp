@@ -15,8 +15,7 @@ std::vector<char> folded_faces(const Points3Ref& starts, const Points3Ref& ends,
 
 // Re-places the ends of folded triangles (see unfold.cpp) and returns how many triangles are still
 // folded. `ends` must lie on (v2, f2); rows that are NaN stay NaN.
-Index unfold(const Points3Ref& starts, Points3& ends, const FacesRef& faces, const Points3Ref& v1,
-             const FacesRef& f1, const SurfaceIndex& index1, const Points3Ref& v2, const FacesRef& f2,
-             const SurfaceIndex& index2);
+Index unfold(const Points3Ref& starts, Points3& ends, const FacesRef& faces, const Points3Ref& v1, const FacesRef& f1,
+             const SurfaceIndex& index1, const Points3Ref& v2, const FacesRef& f2, const SurfaceIndex& index2);
 
 }  // namespace morphomap::detail

@@ -35,23 +35,10 @@ struct Located {
   std::vector<Index> segment;
 };
 
-Index segment_of(const ArcCurve& curve, double s) {
-  const Index segments = curve.closed() ? curve.size() : curve.size() - 1;
-  Index lo = 0, hi = segments;  // first segment starting after s
-  while (lo < hi) {
-    const Index mid = lo + (hi - lo) / 2;
-    if (curve.arc(mid) <= s) lo = mid + 1;
-    else hi = mid;
-  }
-  return std::max<Index>(0, lo - 1);
-}
+double diagonal(const Points2Ref& points) { return (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm(); }
 
-double diagonal(const Points2Ref& points) {
-  return (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
-}
-
-Located locate(const Points2& points, const std::vector<Index>& rows, const ArcCurve& curve,
-               const Points2Ref& raw, const char* which, const char* curve_name, Index total) {
+Located locate(const Points2& points, const std::vector<Index>& rows, const ArcCurve& curve, const Points2Ref& raw,
+               const char* which, const char* curve_name, Index total) {
   Points2 queries(static_cast<Index>(rows.size()), 2);
   for (std::size_t k = 0; k < rows.size(); ++k) queries.row(k) = points.row(rows[k]);
   const CurveHits hits = CurveIndex(raw, curve.closed()).closest_points(queries);
@@ -59,9 +46,8 @@ Located locate(const Points2& points, const std::vector<Index>& rows, const ArcC
   const double tol = kOnCurve * diagonal(curve.points());
   for (std::size_t k = 0; k < rows.size(); ++k) {
     if (!(hits.distances[k] <= tol)) {
-      detail::invalid("field", std::string(which) + " point " + std::to_string(rows[k]) +
-                                   " is not on " + curve_name + " (distance " +
-                                   std::to_string(hits.distances[k]) + ")");
+      detail::invalid("field", std::string(which) + " point " + std::to_string(rows[k]) + " is not on " + curve_name +
+                                   " (distance " + std::to_string(hits.distances[k]) + ")");
     }
   }
   Located out{std::vector<double>(total, kNaN), std::vector<Index>(total, 0)};
@@ -70,7 +56,7 @@ Located locate(const Points2& points, const std::vector<Index>& rows, const ArcC
                       for (std::size_t k = range.begin(); k != range.end(); ++k) {
                         const double s = curve.wrap(hits.arc_lengths[k]);
                         out.arc[rows[k]] = s;
-                        out.segment[rows[k]] = segment_of(curve, s);
+                        out.segment[rows[k]] = curve.segment_at(s);
                       }
                     });
   return out;
@@ -127,12 +113,11 @@ double finite_mean(const std::vector<double>& values) {
 
 }  // namespace
 
-CurveQuality quality(const DisplacementField2& field, const Points2Ref& c1, const Points2Ref& c2,
-                     bool closed) {
+CurveQuality quality(const DisplacementField2& field, const Points2Ref& c1, const Points2Ref& c2, bool closed) {
   const Index m = field.size();
   if (field.ends.rows() != m) {
-    detail::invalid("field", "has " + std::to_string(m) + " start points but " +
-                                 std::to_string(field.ends.rows()) + " end points");
+    detail::invalid(
+        "field", "has " + std::to_string(m) + " start points but " + std::to_string(field.ends.rows()) + " end points");
   }
   const ArcCurve curve1(c1, closed, "c1");
   const ArcCurve curve2(c2, closed, "c2");

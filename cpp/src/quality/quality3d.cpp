@@ -97,7 +97,8 @@ Points3 normals_under(const Points3Ref& points, const FacesRef& faces, const std
   {
     const Points3 queries = points(rows, Eigen::all);
     const IndexVector hit = index.closest_points(queries).faces;
-    for (std::size_t k = 0; k < rows.size(); ++k) at_rows.row(rows[k]) = unit_face_normal(v, f, hit[k], name).transpose();
+    for (std::size_t k = 0; k < rows.size(); ++k)
+      at_rows.row(rows[k]) = unit_face_normal(v, f, hit[k], name).transpose();
   }
   std::vector<Index> triangles;
   for (Index j = 0; j < faces.rows(); ++j) {
@@ -112,8 +113,8 @@ Points3 normals_under(const Points3Ref& points, const FacesRef& faces, const std
   const IndexVector hit = index.closest_points(centroids).faces;
   for (std::size_t k = 0; k < triangles.size(); ++k) {
     const Index j = triangles[k];
-    nu.row(j) = unit_face_normal(v, f, hit[k], name).transpose() + at_rows.row(faces(j, 0)) +
-                at_rows.row(faces(j, 1)) + at_rows.row(faces(j, 2));
+    nu.row(j) = unit_face_normal(v, f, hit[k], name).transpose() + at_rows.row(faces(j, 0)) + at_rows.row(faces(j, 1)) +
+                at_rows.row(faces(j, 2));
   }
   return nu;
 }
@@ -158,8 +159,8 @@ Index count_folds(const Points3Ref& starts, const Points3Ref& ends, const FacesR
   return count_folds(starts, ends, faces, v1, f1, SurfaceIndex(v1, f1), v2, f2, SurfaceIndex(v2, f2));
 }
 
-SurfaceQuality quality(const DisplacementField3& field, const Points3Ref& v1, const FacesRef& f1,
-                       const Points3Ref& v2, const FacesRef& f2) {
+SurfaceQuality quality(const DisplacementField3& field, const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2,
+                       const FacesRef& f2) {
   detail::require_outward(check_closed_surface(v1, f1, "s1"), "s1");
   detail::require_outward(check_closed_surface(v2, f2, "s2"), "s2");
   if (field.ends.rows() != field.starts.rows() || field.starts.cols() != 3 || field.ends.cols() != 3) {

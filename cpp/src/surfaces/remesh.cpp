@@ -26,7 +26,8 @@ namespace PMP = CGAL::Polygon_mesh_processing;
 namespace {
 
 void require_input(const Points3Ref& vertices, const FacesRef& faces) {
-  if (faces.rows() < 4) detail::invalid("surface", "has " + std::to_string(faces.rows()) + " faces: a closed surface needs at least 4");
+  if (faces.rows() < 4)
+    detail::invalid("surface", "has " + std::to_string(faces.rows()) + " faces: a closed surface needs at least 4");
   if (!vertices.allFinite()) detail::invalid("surface", "has a vertex with a non-finite coordinate");
   for (Index f = 0; f < faces.rows(); ++f) {
     for (int i = 0; i < 3; ++i) {
@@ -52,7 +53,8 @@ TriangleSurface remesh_surface(const Points3Ref& vertices, const FacesRef& trian
   try {
     mesh = detail::to_surface_mesh(vertices, triangles);
   } catch (const GeometryError&) {
-    detail::invalid("surface", "is not a manifold triangle mesh (an edge has more than two faces or a face is repeated)");
+    detail::invalid("surface",
+                    "is not a manifold triangle mesh (an edge has more than two faces or a face is repeated)");
   }
   if (!CGAL::is_closed(mesh)) detail::invalid("surface", "is not closed (it has boundary edges)");
   auto component = mesh.add_property_map<detail::SurfaceMesh::Face_index, std::size_t>("f:component", 0).first;

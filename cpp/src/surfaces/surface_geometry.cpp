@@ -29,8 +29,8 @@ void require_face_indices(const FacesRef& faces, Index vertex_count, const char*
     for (int k = 0; k < 3; ++k) {
       const Index v = faces(j, k);
       if (v < 0 || v >= vertex_count) {
-        invalid(name, "face " + std::to_string(j) + " refers to vertex " + std::to_string(v) +
-                          ", outside 0.." + std::to_string(vertex_count - 1));
+        invalid(name, "face " + std::to_string(j) + " refers to vertex " + std::to_string(v) + ", outside 0.." +
+                          std::to_string(vertex_count - 1));
       }
     }
   }
@@ -108,12 +108,14 @@ double check_closed_surface(const Points3Ref& vertices, const FacesRef& faces, c
     const auto [a, b] = edges[e];
     const std::string edge = "(" + std::to_string(a) + ", " + std::to_string(b) + ")";
     if (e + 1 < edges.size() && edges[e + 1] == edges[e]) {
-      detail::invalid(name, "edge " + edge + " is used twice in the same direction: the faces are not "
-                            "consistently oriented, or more than two faces meet at the edge");
+      detail::invalid(name, "edge " + edge +
+                                " is used twice in the same direction: the faces are not "
+                                "consistently oriented, or more than two faces meet at the edge");
     }
     if (!std::binary_search(edges.begin(), edges.end(), std::make_pair(b, a))) {
-      detail::invalid(name, "the surface is not closed: edge " + edge + " belongs to one face only "
-                            "(or its neighbour is oriented the other way)");
+      detail::invalid(name, "the surface is not closed: edge " + edge +
+                                " belongs to one face only "
+                                "(or its neighbour is oriented the other way)");
     }
   }
   // Every vertex used (an unused one has no normal, and no place on the surface).
@@ -123,7 +125,8 @@ double check_closed_surface(const Points3Ref& vertices, const FacesRef& faces, c
   }
   const auto unused = std::find(used.begin(), used.end(), 0);
   if (unused != used.end()) {
-    detail::invalid(name, "vertex " + std::to_string(unused - used.begin()) + " (of " + std::to_string(vertices.rows()) +
+    detail::invalid(name, "vertex " + std::to_string(unused - used.begin()) + " (of " +
+                              std::to_string(vertices.rows()) +
                               ") is used by no face: drop unused vertices first (trimesh: "
                               "mesh.remove_unreferenced_vertices())");
   }

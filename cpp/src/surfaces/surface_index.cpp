@@ -23,8 +23,8 @@
 
 namespace morphomap {
 
-using detail::kNaN;
 using detail::kInf;
+using detail::kNaN;
 
 namespace {
 
@@ -87,7 +87,7 @@ struct SurfaceIndex::Impl {
   Points3 vertices;
   Faces faces;
   V3 centre = V3::Zero();
-  double scale = 1.0;  // unit-box coordinates are (x - centre) * scale
+  double scale = 1.0;                         // unit-box coordinates are (x - centre) * scale
   std::vector<Index> ring_start, ring_faces;  // faces around each vertex (CSR)
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
@@ -309,7 +309,7 @@ struct SurfaceIndex::Impl {
         std::uint32_t c = 0;
         for (int k = 0; k < 3; ++k) {
           const double x = ((origins(i, k) - centre[k]) * scale + 0.5) * cells;
-          const std::uint32_t q = x <= 0.0                               ? 0u
+          const std::uint32_t q = x <= 0.0                              ? 0u
                                   : x >= static_cast<double>(cells - 1) ? cells - 1
                                                                         : static_cast<std::uint32_t>(x);
           for (int bit = 0; bit < kOrderBits; ++bit) c |= ((q >> bit) & 1u) << (3 * bit + k);

@@ -26,8 +26,7 @@ inline SurfaceMesh to_surface_mesh(const Points3Ref& vertices, const FacesRef& f
     if (used[v]) handle[v] = mesh.add_vertex({vertices(v, 0), vertices(v, 1), vertices(v, 2)});
   }
   for (Index f = 0; f < faces.rows(); ++f) {
-    if (mesh.add_face(handle[faces(f, 0)], handle[faces(f, 1)], handle[faces(f, 2)]) ==
-        SurfaceMesh::null_face()) {
+    if (mesh.add_face(handle[faces(f, 0)], handle[faces(f, 1)], handle[faces(f, 2)]) == SurfaceMesh::null_face()) {
       throw GeometryError("a surface is not a manifold triangle mesh");
     }
   }

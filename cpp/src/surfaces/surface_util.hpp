@@ -20,9 +20,7 @@ void require_finite3(const Points3Ref& points, const char* name);
 // Every index in [0, vertex_count), else InvalidInput naming `name`.
 void require_face_indices(const FacesRef& faces, Index vertex_count, const char* name);
 
-inline V3 corner(const Points3Ref& v, const FacesRef& f, Index face, int k) {
-  return v.row(f(face, k)).transpose();
-}
+inline V3 corner(const Points3Ref& v, const FacesRef& f, Index face, int k) { return v.row(f(face, k)).transpose(); }
 
 // Closest point to p on triangle abc (Ericson, "Real-Time Collision Detection" 5.1.5: walk the
 // Voronoi regions of the vertices, edges and face); exact for degenerate triangles too.
@@ -63,8 +61,8 @@ inline V3 closest_on_triangle(const V3& p, const V3& a, const V3& b, const V3& c
 // Intersection of the line o + t u with triangle abc (Moller-Trumbore in double precision);
 // barycentric coordinates may be outside [0, 1] by `slack`. False for a line parallel to the
 // triangle's plane.
-inline bool line_triangle(const V3& o, const V3& u, const V3& a, const V3& b, const V3& c,
-                          double slack, double& t, double& outside) {
+inline bool line_triangle(const V3& o, const V3& u, const V3& a, const V3& b, const V3& c, double slack, double& t,
+                          double& outside) {
   const V3 e1 = b - a, e2 = c - a;
   const V3 pvec = u.cross(e2);
   const double det = e1.dot(pvec);
