@@ -74,14 +74,18 @@ def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False) -> ShellDif
     mesh_size : float, optional
         Largest tetrahedron size. Default: a quarter of the mean gap (the region's volume over the
         mean area of the surfaces). Near each surface the mesh follows its mean edge length (or
-        ``mesh_size`` if smaller) and grows by a tenth of the distance away from it.
+        ``mesh_size`` if smaller), but no finer than 1% of the surface's bounding diagonal (where
+        the surface curves more tightly, the boundary facets still follow it to a fifth of that
+        size), and grows by a tenth of the distance away from it.
     streamlines : bool
         Keep the polyline of each streamline.
 
     Returns
     -------
     ShellDiffusionSolution
-        ``ends[i]`` is the image of vertex ``i`` of S1 on S2.
+        ``ends[i]`` is the image of vertex ``i`` of S1 on S2. The same input gives the same mesh,
+        potential and ends, bit for bit, in any process and with any number of threads (the
+        mesher runs on one core with fixed random choices).
     """
     v1, f1 = as_surface(s1, "s1")
     v2, f2 = as_surface(s2, "s2")
