@@ -248,3 +248,15 @@ def test_same_input_same_mesh_and_field_in_other_processes_and_thread_counts():
     lines = [line for run in runs for line in run.stdout.split()]
     assert len(lines) == 6 and int(lines[0]) > 1000
     assert len(set(lines[1::2])) == 1, lines
+
+
+def test_progress_reports_the_stages(capsys):
+    s1, s2 = sphere(1.0, 2), sphere(axes=(2.0, 1.5, 1.2), subdivisions=2)
+    quiet = mm.solve_diffusion_3d(s1, s2, progress=False)
+    assert capsys.readouterr().err == ""
+    shown = mm.solve_diffusion_3d(s1, s2, progress=True)
+    err = capsys.readouterr().err
+    assert "solve_diffusion_3d" in err and "3/3" in err and "trace" in err, err
+    np.testing.assert_array_equal(shown.ends, quiet.ends)  # the report changes nothing
+    with pytest.raises(TypeError, match="progress"):
+        mm.solve_diffusion_3d(s1, s2, progress="yes")

@@ -369,6 +369,10 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
   if (source.volume < 0.0) source_out.col(1).swap(source_out.col(2));
   if (target.volume < 0.0) target_out.col(1).swap(target_out.col(2));
 
+  const auto stage = [&](const char* name) {
+    if (options.on_stage) options.on_stage(name);
+  };
+  stage("mesh");
   auto clock = std::chrono::steady_clock::now();
   detail::Nesting nesting = detail::classify_nesting(source_vertices, source_out, target_vertices, target_out);
   if (nesting == detail::Nesting::disjoint) {
@@ -456,6 +460,7 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
 
   ShellDiffusionSolution solution;
   solution.seconds.mesh = seconds_since(clock);
+  stage("solve");
   clock = std::chrono::steady_clock::now();
 
   const Index nv = mesh.vertices.rows(), nt = mesh.tetrahedra.rows();
@@ -476,6 +481,7 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
   if (source_facets.empty()) throw GeometryError("the mesh of the region has no face on s1");
   solution.potential = solve_potential(mesh, kind);
   solution.seconds.solve = seconds_since(clock);
+  stage("trace");
   clock = std::chrono::steady_clock::now();
 
   // Start points: the closest point of the mesh's source boundary to each source vertex.

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numbers
+import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -52,7 +53,38 @@ def _mesh_size(value):
     return value
 
 
-def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False) -> ShellDiffusionSolution:
+class _StageBar:
+    """A tqdm bar over the three stages, shown once a call has run for a few seconds (at once with
+    progress=True); nothing without tqdm, with progress=False, or (by default) off a terminal."""
+
+    STAGES = ("mesh", "solve", "trace")
+
+    def __init__(self, progress):
+        if progress is not None and not isinstance(progress, (bool, np.bool_)):
+            raise TypeError(f"progress: expected True, False or None, got {type(progress).__name__}")
+        self.bar = None
+        if progress is False or (progress is None and not sys.stderr.isatty()):
+            return
+        try:
+            from tqdm import tqdm
+        except ImportError:  # progress is a courtesy, never a requirement
+            return
+        self.bar = tqdm(total=len(self.STAGES), desc="solve_diffusion_3d", unit="stage", delay=0 if progress else 3)
+
+    def on_stage(self, stage):
+        if self.bar is None:
+            return
+        done = self.STAGES.index(stage)
+        self.bar.update(done - self.bar.n)
+        self.bar.set_postfix_str(stage)
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.update(len(self.STAGES) - self.bar.n)
+            self.bar.close()
+
+
+def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False, progress=None) -> ShellDiffusionSolution:
     """Solve Laplace's equation between S1 (c = 1) and S2 (c = 0) and trace the streamlines.
 
     Parameters
@@ -79,6 +111,9 @@ def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False) -> ShellDif
         size), and grows by a tenth of the distance away from it.
     streamlines : bool
         Keep the polyline of each streamline.
+    progress : bool, optional
+        A progress bar (tqdm) on stderr naming the stage (mesh, solve, trace); by default when
+        stderr is a terminal and the call runs longer than 3 seconds.
 
     Returns
     -------
@@ -89,6 +124,11 @@ def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False) -> ShellDif
     """
     v1, f1 = as_surface(s1, "s1")
     v2, f2 = as_surface(s2, "s2")
-    solved = _core.solve_diffusion_3d(v1, f1, v2, f2, _mesh_size(mesh_size), as_flag(streamlines, "streamlines"))
+    size, keep = _mesh_size(mesh_size), as_flag(streamlines, "streamlines")
+    bar = _StageBar(progress)
+    try:
+        solved = _core.solve_diffusion_3d(v1, f1, v2, f2, size, keep, bar.on_stage if bar.bar is not None else None)
+    finally:
+        bar.close()
     return ShellDiffusionSolution(solved["vertices"], solved["tetrahedra"], solved["potential"], solved["ends"],
                                   solved["touching"], list(solved["streamlines"]), dict(solved["seconds"]))
