@@ -411,8 +411,8 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
   // there: concentric spheres r = 1 -> 4 with 642 vertices gave RMS 0.018 at the triangles' size).
   // Nor does it follow triangles finer than 1% of a surface's diagonal: a finer spacing describes
   // the surface, not a shape the field must resolve (where the surface curves, facet_distance
-  // refines), and following it made the mesh grow with the surfaces' resolution (a lumpy nested
-  // pair: 1.0 M tetrahedra at 100k faces, 2.3 M at 200k).
+  // refines), and following it made the mesh grow with the surfaces' resolution (five times the
+  // tetrahedra, eight times the time, for a lumpy pair of 100k faces; bench/README.md).
   const double source_diagonal = (source_vertices.colwise().maxCoeff() - source_vertices.colwise().minCoeff()).norm();
   const double target_diagonal = (target_vertices.colwise().maxCoeff() - target_vertices.colwise().minCoeff()).norm();
   criteria.source_size = std::min({std::max(source.mean_edge, kFinestFraction * source_diagonal), criteria.cell_size,

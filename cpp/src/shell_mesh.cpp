@@ -103,10 +103,9 @@ void seed_patch(C3t3& c3t3, const Domain& domain, const SurfaceMesh& surface, in
 // Delaunay refinement of the complex to the criteria (no perturbation), then optionally exudation
 // of slivers until no dihedral angle is below 30 degrees, without a time limit. By default Mesh_3
 // stops exudation after as many seconds as the refinement took, so how many slivers it removed
-// depended on the machine's load (the same input gave 49,877 or 49,879 tetrahedra, and other
-// ends, from call to call); with no bound it removes every sliver it can (2.2x the CPU time of the
-// whole meshing between concentric spheres, for no better ends). At 30 degrees the concentric
-// spheres, the Figure 12 pair and the crossing pair end as with the time limit (bench/README.md).
+// depended on the machine's load, and the same input gave other meshes and ends from call to
+// call. Without a bound it removes every sliver it can, at twice the CPU time of the whole
+// meshing for no better ends; at 30 degrees the ends are as good as before (bench/README.md).
 constexpr double kSliverBound = 30.0;
 
 void refine(C3t3& c3t3, const Domain& domain, const Criteria& criteria, bool exude) {
