@@ -12,11 +12,20 @@
 3. Crossing surfaces: the unit sphere and the ellipsoid with semi-axes 1.3, 1, 1 centred at
    (0.6, 0.05, 0.03); no closed form, so the map back (S2 -> S1, interpolated at the images) is
    compared with the starts.
+4. Organ scale (--organ): lumpy nested pairs of 10k to 200k faces per surface, end to end, with
+   peak memory, beside the pipeline a user would assemble: TetGen (PyPI `tetgen`, AGPL: measured
+   only, never a dependency) meshing the shell with quality switches, then scikit-fem's P1
+   assembly. Each case runs in its own process; peak memory is the process's plus its children's
+   (the mesher's) largest resident sets, an upper bound.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import resource
+import subprocess
+import sys
 import time
 
 import numpy as np
@@ -107,6 +116,123 @@ def crossing_table(sizes):
               f"{error.max():>9.2e} {stages(forward)} {total:6.2f}")
 
 
+def geodesic_sphere(frequency):
+    """The unit sphere with each icosahedron face cut into frequency**2 triangles (20 f**2 faces)."""
+    ico = trimesh.creation.icosahedron()
+    n = frequency
+    i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
+    keep = i + j <= n
+    i, j = i[keep], j[keep]
+    index = -np.ones((n + 1, n + 1), int)
+    index[i, j] = np.arange(len(i))
+    a, b = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
+    up, down = a + b < n, a + b < n - 1
+    local = np.vstack([np.stack([index[a[up], b[up]], index[a[up] + 1, b[up]], index[a[up], b[up] + 1]], 1),
+                       np.stack([index[a[down] + 1, b[down]], index[a[down] + 1, b[down] + 1],
+                                 index[a[down], b[down] + 1]], 1)])
+    corners = ico.vertices[ico.faces]
+    points = np.vstack([p + np.outer(i / n, q - p) + np.outer(j / n, r - p) for p, q, r in corners])
+    faces = np.vstack([local + k * len(i) for k in range(len(corners))])
+    points /= np.linalg.norm(points, axis=1, keepdims=True)
+    _, first, inverse = np.unique(np.round(points, 9), axis=0, return_index=True, return_inverse=True)
+    return points[first], inverse.reshape(-1)[faces]
+
+
+def lumpy_radius(directions, seed, amplitude):
+    """1 plus eight Gaussian bumps and dents of random axes and widths."""
+    rng = np.random.default_rng(seed)
+    r = np.ones(len(directions))
+    for _ in range(8):
+        axis = rng.normal(size=3)
+        axis /= np.linalg.norm(axis)
+        width, height = rng.uniform(0.3, 0.7), amplitude * rng.uniform(-1, 1)
+        r += height * np.exp(-0.5 * (np.arccos(np.clip(directions @ axis, -1, 1)) / width) ** 2)
+    return r
+
+
+def lumpy_nested_pair(faces):
+    """A lumpy ball of radius about 1 inside one of radius about 2, each with about `faces` faces."""
+    u, triangles = geodesic_sphere(int(np.sqrt(faces / 20) + 0.5))
+    return (u * lumpy_radius(u, 1, 0.15)[:, None], triangles), (2.0 * u * lumpy_radius(u, 2, 0.15)[:, None], triangles)
+
+
+def peak_memory_gb():
+    """Largest resident sets of this process and of its children (the mesher), summed: GB."""
+    kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss + resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    return kb / 2**20
+
+
+def cpu_seconds():
+    """User and system time of this process and its children (the mesher)."""
+    own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+
+
+def organ_morphomap(faces):
+    s1, s2 = lumpy_nested_pair(faces)
+    cpu = cpu_seconds()
+    solution, total = timed(s1, s2, None)
+    cpu = cpu_seconds() - cpu
+    lost = int((~np.isfinite(solution.ends).all(axis=1)).sum())
+    field = mm.DisplacementField(s1[0], np.nan_to_num(solution.ends), np.full(len(s1[0]), "diffusion"), faces=s1[1])
+    return {"faces": len(s1[1]), "tetrahedra": len(solution.tetrahedra), **solution.seconds, "total": total, "cpu": cpu,
+            "lost": lost, "folds": int(mm.quality(field, s1, s2).folds), "memory": peak_memory_gb()}
+
+
+def organ_peer(faces):
+    """TetGen on both surfaces (the shell: a hole inside S1), then scikit-fem's P1 stiffness matrix."""
+    import skfem
+    import tetgen
+    from skfem.models.poisson import laplace
+
+    (v1, f1), (v2, f2) = lumpy_nested_pair(faces)
+    cpu = cpu_seconds()
+    start = time.perf_counter()
+    generator = tetgen.TetGen(np.vstack([v1, v2]), np.vstack([f1, f2 + len(v1)]).astype(np.int32))
+    generator.add_hole([0.0, 0.0, 0.0])
+    nodes, elements = generator.tetrahedralize(quality=True, minratio=1.5, mindihedral=10.0)[:2]
+    meshed = time.perf_counter()
+    basis = skfem.Basis(skfem.MeshTet(nodes.T, elements.T.astype(np.int64)), skfem.ElementTetP1())
+    skfem.asm(laplace, basis)
+    assembled = time.perf_counter()
+    return {"faces": len(f1), "tetrahedra": len(elements), "mesh": meshed - start, "assembly": assembled - meshed,
+            "cpu": cpu_seconds() - cpu, "memory": peak_memory_gb()}
+
+
+def organ_table(sizes, peer_sizes):
+    """Each case in a fresh process (peak memory of its own), the peer beside it."""
+    def run(kind, faces):
+        done = subprocess.run([sys.executable, __file__, "--case", kind, str(faces)], capture_output=True, text=True, check=False)
+        if done.returncode != 0:
+            return {"error": done.stderr.strip().splitlines()[-1:]}
+        return json.loads(done.stdout.strip().splitlines()[-1])
+
+    print("\n4. Lumpy nested pairs (radius ~1 in ~2): end to end, and TetGen + scikit-fem assembly")
+    print("| faces per surface | tetrahedra | mesh s | solve s | trace s | total s | CPU s | lost | folds "
+          "| peak memory GB | TetGen tetrahedra | TetGen s | assembly s | peer CPU s | peer memory GB "
+          "| peer / morphomap (wall, CPU) |")
+    print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    totals = []
+    for faces in sizes:
+        ours = run("morphomap", faces)
+        peer = run("peer", faces) if faces in peer_sizes else None
+        totals.append((ours["faces"], ours["cpu"]))
+        row = (f"| {ours['faces']:,} | {ours['tetrahedra']:,} | {ours['mesh']:.1f} | {ours['solve']:.2f} | "
+               f"{ours['trace']:.2f} | {ours['total']:.1f} | {ours['cpu']:.1f} | {ours['lost']} | {ours['folds']} | "
+               f"{ours['memory']:.2f} |")
+        if peer and "error" not in peer:
+            ratio = (peer["mesh"] + peer["assembly"]) / ours["total"]
+            row += (f" {peer['tetrahedra']:,} | {peer['mesh']:.1f} | {peer['assembly']:.1f} | {peer['cpu']:.1f} | "
+                    f"{peer['memory']:.2f} | {ratio:.1f}x, {peer['cpu'] / ours['cpu']:.1f}x |")
+        else:
+            row += f" {peer['error'] if peer else 'not run'} | | | | | |"
+        print(row, flush=True)
+    if len(totals) >= 2:
+        (n0, t0), (n1, t1) = totals[0], totals[-1]
+        print(f"growth exponent of the total CPU time from {n0:,} to {n1:,} faces: "
+              f"{np.log(t1 / t0) / np.log(n1 / n0):.2f}")
+
+
 @pytest.mark.parametrize("case", ("concentric", "figure12", "crossing"))
 def test_diffusion3d_default(benchmark, case):
     if case == "concentric":
@@ -124,7 +250,16 @@ def test_diffusion3d_default(benchmark, case):
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quick", action="store_true", help="default mesh sizes only")
+    parser.add_argument("--organ", action="store_true", help="only the organ-scale table (4), ~10 min")
+    parser.add_argument("--case", nargs=2, metavar=("KIND", "FACES"), help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.case:
+        kind, faces = args.case[0], int(args.case[1])
+        print(json.dumps(organ_morphomap(faces) if kind == "morphomap" else organ_peer(faces)))
+        return
+    if args.organ:
+        organ_table([10_000, 20_000, 100_000, 200_000], {20_000, 100_000, 200_000})
+        return
     # mesh_size only caps the size: near the surfaces the mesh follows their spacing (inner sphere
     # 0.077, outer 0.31, ellipsoid 0.05), so the caps below are what refines it.
     concentric_table([(4, None)] if args.quick else [(3, None), (4, None), (5, None), (4, 0.3), (4, 0.2), (4, 0.15)])

@@ -216,3 +216,47 @@ def test_a_coarse_inner_sphere_is_as_accurate_by_default():
     solution = mm.solve_diffusion_3d(inner, outer)
     assert np.isfinite(solution.ends).all()
     assert angular_rms(inner[0], solution.ends, 4.0) < 0.01
+
+
+_REPEAT_SCRIPT = """
+import hashlib, os, sys
+import numpy as np, trimesh
+if sys.argv[1] == "one":
+    os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})  # TBB then runs one thread
+import morphomap as mm
+a, b = trimesh.creation.icosphere(2), trimesh.creation.icosphere(2)
+s1 = (np.array(a.vertices), np.array(a.faces))
+s2 = (np.array(b.vertices) * [2.0, 1.5, 1.2] + [0.1, 0.0, 0.0], np.array(b.faces))
+for _ in range(2 if sys.argv[1] == "all" else 1):  # twice in one process, once in the other
+    solved = mm.solve_diffusion_3d(s1, s2)
+    digest = hashlib.sha256()
+    for array in (solved.vertices, solved.tetrahedra, solved.potential, solved.ends):
+        digest.update(np.ascontiguousarray(array).tobytes())
+    print(len(solved.tetrahedra), digest.hexdigest())
+"""
+
+
+@pytest.mark.skipif(not hasattr(__import__("os"), "sched_setaffinity"), reason="needs sched_setaffinity")
+def test_same_input_same_mesh_and_field_in_other_processes_and_thread_counts():
+    # Mesh_3 used to stop exudation after a wall-clock time, so that the mesh (and the ends, by up
+    # to 4e-3) changed with the machine's load from call to call.
+    import subprocess
+    import sys
+
+    runs = [subprocess.run([sys.executable, "-c", _REPEAT_SCRIPT, threads], capture_output=True, text=True, check=True)
+            for threads in ("all", "one")]
+    lines = [line for run in runs for line in run.stdout.split()]
+    assert len(lines) == 6 and int(lines[0]) > 1000
+    assert len(set(lines[1::2])) == 1, lines
+
+
+def test_progress_reports_the_stages(capsys):
+    s1, s2 = sphere(1.0, 2), sphere(axes=(2.0, 1.5, 1.2), subdivisions=2)
+    quiet = mm.solve_diffusion_3d(s1, s2, progress=False)
+    assert capsys.readouterr().err == ""
+    shown = mm.solve_diffusion_3d(s1, s2, progress=True)
+    err = capsys.readouterr().err
+    assert "solve_diffusion_3d" in err and "3/3" in err and "trace" in err, err
+    np.testing.assert_array_equal(shown.ends, quiet.ends)  # the report changes nothing
+    with pytest.raises(TypeError, match="progress"):
+        mm.solve_diffusion_3d(s1, s2, progress="yes")

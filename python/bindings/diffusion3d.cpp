@@ -17,10 +17,17 @@ void bind_diffusion3d(py::module_& m) {
   m.def(
       "solve_diffusion_3d",
       [](const Points3Ref& source_vertices, const FacesRef& source_faces, const Points3Ref& target_vertices,
-         const FacesRef& target_faces, double mesh_size, bool keep_streamlines) {
+         const FacesRef& target_faces, double mesh_size, bool keep_streamlines, const py::object& on_stage) {
         ShellDiffusionOptions options;
         options.mesh_size = mesh_size;
         options.keep_streamlines = keep_streamlines;
+        if (!on_stage.is_none()) {
+          // The core calls it on this thread with the GIL released: taken back for the call only.
+          options.on_stage = [&on_stage](const char* stage) {
+            py::gil_scoped_acquire acquire;
+            on_stage(stage);
+          };
+        }
         ShellDiffusionSolution solution;
         InterruptGuard interruptible;
         {
@@ -46,5 +53,5 @@ void bind_diffusion3d(py::module_& m) {
         return result;
       },
       py::arg("source_vertices"), py::arg("source_faces"), py::arg("target_vertices"), py::arg("target_faces"),
-      py::arg("mesh_size"), py::arg("keep_streamlines"));
+      py::arg("mesh_size"), py::arg("keep_streamlines"), py::arg("on_stage") = py::none());
 }

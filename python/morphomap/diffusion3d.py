@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numbers
+import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -52,7 +53,38 @@ def _mesh_size(value):
     return value
 
 
-def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False) -> ShellDiffusionSolution:
+class _StageBar:
+    """A tqdm bar over the three stages, shown once a call has run for a few seconds (at once with
+    progress=True); nothing without tqdm, with progress=False, or (by default) off a terminal."""
+
+    STAGES = ("mesh", "solve", "trace")
+
+    def __init__(self, progress):
+        if progress is not None and not isinstance(progress, (bool, np.bool_)):
+            raise TypeError(f"progress: expected True, False or None, got {type(progress).__name__}")
+        self.bar = None
+        if progress is False or (progress is None and not sys.stderr.isatty()):
+            return
+        try:
+            from tqdm import tqdm
+        except ImportError:  # progress is a courtesy, never a requirement
+            return
+        self.bar = tqdm(total=len(self.STAGES), desc="solve_diffusion_3d", unit="stage", delay=0 if progress else 3)
+
+    def on_stage(self, stage):
+        if self.bar is None:
+            return
+        done = self.STAGES.index(stage)
+        self.bar.update(done - self.bar.n)
+        self.bar.set_postfix_str(stage)
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.update(len(self.STAGES) - self.bar.n)
+            self.bar.close()
+
+
+def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False, progress=None) -> ShellDiffusionSolution:
     """Solve Laplace's equation between S1 (c = 1) and S2 (c = 0) and trace the streamlines.
 
     Parameters
@@ -74,17 +106,29 @@ def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False) -> ShellDif
     mesh_size : float, optional
         Largest tetrahedron size. Default: a quarter of the mean gap (the region's volume over the
         mean area of the surfaces). Near each surface the mesh follows its mean edge length (or
-        ``mesh_size`` if smaller) and grows by a tenth of the distance away from it.
+        ``mesh_size`` if smaller), but no finer than 1% of the surface's bounding diagonal (where
+        the surface curves more tightly, the boundary facets still follow it to a fifth of that
+        size), and grows by a tenth of the distance away from it.
     streamlines : bool
         Keep the polyline of each streamline.
+    progress : bool, optional
+        A progress bar (tqdm) on stderr naming the stage (mesh, solve, trace); by default when
+        stderr is a terminal and the call runs longer than 3 seconds.
 
     Returns
     -------
     ShellDiffusionSolution
-        ``ends[i]`` is the image of vertex ``i`` of S1 on S2.
+        ``ends[i]`` is the image of vertex ``i`` of S1 on S2. The same input gives the same mesh,
+        potential and ends, bit for bit, in any process and with any number of threads (the
+        mesher runs on one core with fixed random choices).
     """
     v1, f1 = as_surface(s1, "s1")
     v2, f2 = as_surface(s2, "s2")
-    solved = _core.solve_diffusion_3d(v1, f1, v2, f2, _mesh_size(mesh_size), as_flag(streamlines, "streamlines"))
+    size, keep = _mesh_size(mesh_size), as_flag(streamlines, "streamlines")
+    bar = _StageBar(progress)
+    try:
+        solved = _core.solve_diffusion_3d(v1, f1, v2, f2, size, keep, bar.on_stage if bar.bar is not None else None)
+    finally:
+        bar.close()
     return ShellDiffusionSolution(solved["vertices"], solved["tetrahedra"], solved["potential"], solved["ends"],
                                   solved["touching"], list(solved["streamlines"]), dict(solved["seconds"]))

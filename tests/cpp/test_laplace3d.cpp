@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -98,6 +99,16 @@ void inwards_and_flipped() {
   CHECK(rms < 0.01);
 }
 
+// The progress callback hears each stage once, in order.
+void stages_reported() {
+  const Surface inner = icosphere(2), outer = scaled(icosphere(2), 3, 3, 3);
+  std::vector<std::string> stages;
+  ShellDiffusionOptions options;
+  options.on_stage = [&](const char* stage) { stages.emplace_back(stage); };
+  solve_diffusion_3d(inner.vertices, inner.faces, outer.vertices, outer.faces, options);
+  CHECK((stages == std::vector<std::string>{"mesh", "solve", "trace"}));
+}
+
 // Sphere onto an ellipsoid: every streamline arrives.
 void sphere_to_ellipsoid() {
   const Surface sphere = icosphere(3), ellipsoid = scaled(icosphere(3), 2.0, 1.5, 1.2);
@@ -161,6 +172,7 @@ int main() {
   bad_input();
   concentric_spheres();
   inwards_and_flipped();
+  stages_reported();
   sphere_to_ellipsoid();
   crossing_surfaces();
   TEST_MAIN_END();

@@ -2,6 +2,7 @@
 // Diffusion mapping in 3D: the Laplace equation in the region between two closed surfaces.
 #include <morphomap/types.hpp>
 
+#include <functional>
 #include <vector>
 
 namespace morphomap {
@@ -13,6 +14,9 @@ struct ShellDiffusionOptions {
   // distance.
   double mesh_size = 0.0;
   bool keep_streamlines = false;
+  // Called with "mesh", "solve" and "trace" as each stage begins, on the calling thread (a
+  // progress report); may be empty.
+  std::function<void(const char* stage)> on_stage;
 };
 
 // Wall-clock seconds of the three stages.

@@ -36,6 +36,7 @@ namespace {
 using Vec3 = Eigen::Vector3d;
 using Vec4 = Eigen::Vector4d;
 constexpr double kSourceFraction = 0.02;
+constexpr double kFinestFraction = 0.01;
 constexpr int kMeshAttempts = 3;
 constexpr double kFacetDistanceNested = 0.2;
 constexpr double kFacetDistanceCrossing = 0.05;
@@ -370,6 +371,10 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
   if (source.volume < 0.0) source_out.col(1).swap(source_out.col(2));
   if (target.volume < 0.0) target_out.col(1).swap(target_out.col(2));
 
+  const auto stage = [&](const char* name) {
+    if (options.on_stage) options.on_stage(name);
+  };
+  stage("mesh");
   auto clock = std::chrono::steady_clock::now();
   detail::Nesting nesting = detail::classify_nesting(source_vertices, source_out, target_vertices, target_out);
   if (nesting == detail::Nesting::disjoint) {
@@ -406,9 +411,15 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
   // Near the source, where the streamlines start, the elements stay within a fraction of the
   // source's size however coarse its triangles are (the end error follows the element size
   // there: concentric spheres r = 1 -> 4 with 642 vertices gave RMS 0.018 at the triangles' size).
+  // Nor does it follow triangles finer than 1% of a surface's diagonal: a finer spacing describes
+  // the surface, not a shape the field must resolve (where the surface curves, facet_distance
+  // refines), and following it made the mesh grow with the surfaces' resolution (five times the
+  // tetrahedra, eight times the time, for a lumpy pair of 100k faces; bench/README.md).
   const double source_diagonal = (source_vertices.colwise().maxCoeff() - source_vertices.colwise().minCoeff()).norm();
-  criteria.source_size = std::min({source.mean_edge, criteria.cell_size, kSourceFraction * source_diagonal});
-  criteria.target_size = std::min(target.mean_edge, criteria.cell_size);
+  const double target_diagonal = (target_vertices.colwise().maxCoeff() - target_vertices.colwise().minCoeff()).norm();
+  criteria.source_size = std::min({std::max(source.mean_edge, kFinestFraction * source_diagonal), criteria.cell_size,
+                                   kSourceFraction * source_diagonal});
+  criteria.target_size = std::min(std::max(target.mean_edge, kFinestFraction * target_diagonal), criteria.cell_size);
   criteria.grading = 0.1;
   criteria.exude = true;
   // Between nested surfaces the boundary facets may stray a fifth of the element size from the
@@ -451,6 +462,7 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
 
   ShellDiffusionSolution solution;
   solution.seconds.mesh = seconds_since(clock);
+  stage("solve");
   clock = std::chrono::steady_clock::now();
 
   const Index nv = mesh.vertices.rows(), nt = mesh.tetrahedra.rows();
@@ -471,6 +483,7 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
   if (source_facets.empty()) throw GeometryError("the mesh of the region has no face on s1");
   solution.potential = solve_potential(mesh, kind);
   solution.seconds.solve = seconds_since(clock);
+  stage("trace");
   clock = std::chrono::steady_clock::now();
 
   // Start points: the closest point of the mesh's source boundary to each source vertex.
