@@ -90,7 +90,8 @@ def concentric_table(cases):
 
 def figure12_table(sizes):
     print("\n2. Unit sphere (2562 vertices) onto the ellipsoid 2, 1.5, 1.2 (10242 vertices): stage seconds")
-    print(f"{'mesh_size':>9} {'tets':>8} {'lost':>5} {'folds':>5} {'|r-1| max':>9} {'mesh':>6} {'solve':>6} {'trace':>6} {'total':>6}")
+    print(f"{'mesh_size':>9} {'tets':>8} {'lost':>5} {'folds':>5} {'|r-1| max':>9} "
+          f"{'mesh':>6} {'solve':>6} {'trace':>6} {'total':>6}")
     s1, s2 = icosphere(4), icosphere(5, FIGURE12_AXES)
     for size in sizes:
         solution, total = timed(s1, s2, size)
@@ -104,7 +105,8 @@ def figure12_table(sizes):
 
 def crossing_table(sizes):
     print("\n3. Crossing: unit sphere and ellipsoid 1.3, 1, 1 through it (2562 vertices each): round trip")
-    print(f"{'mesh_size':>9} {'tets':>8} {'lost':>5} {'RMS':>9} {'max':>9} {'mesh':>6} {'solve':>6} {'trace':>6} {'total':>6}")
+    print(f"{'mesh_size':>9} {'tets':>8} {'lost':>5} {'RMS':>9} {'max':>9} "
+          f"{'mesh':>6} {'solve':>6} {'trace':>6} {'total':>6}")
     s1 = icosphere(4)
     s2 = icosphere(4, CROSSING_AXES, CROSSING_CENTRE)
     for size in sizes:
@@ -202,7 +204,8 @@ def organ_peer(faces):
 def organ_table(sizes, peer_sizes):
     """Each case in a fresh process (peak memory of its own), the peer beside it."""
     def run(kind, faces):
-        done = subprocess.run([sys.executable, __file__, "--case", kind, str(faces)], capture_output=True, text=True, check=False)
+        done = subprocess.run([sys.executable, __file__, "--case", kind, str(faces)], capture_output=True, text=True,
+                              check=False)
         if done.returncode != 0:
             return {"error": done.stderr.strip().splitlines()[-1:]}
         return json.loads(done.stdout.strip().splitlines()[-1])

@@ -13,11 +13,11 @@
 #include "diffusion/mesh_in_child.hpp"
 #include "diffusion/shell_mesh.hpp"
 
+#include <tbb/parallel_for.h>
 #include <Eigen/Dense>
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
@@ -46,10 +46,10 @@ constexpr double kTouchFraction = 0.01;
 // a thinner sliver would need elements of its own thickness.
 constexpr double kClearanceFraction = 0.5;
 constexpr int kClearanceAttempts = 5;
+using detail::crossing_vertex;
 using detail::free_vertex;
 using detail::source_vertex;
 using detail::target_vertex;
-using detail::crossing_vertex;
 
 struct SurfaceFacts {
   double volume = 0.0;  // signed: positive when the faces are oriented outwards
@@ -75,11 +75,14 @@ SurfaceFacts check_surface(const Points3Ref& vertices, const FacesRef& faces, co
 
 // The P1 solution on the tetrahedra: local stiffness volume * grad phi_i . grad phi_j.
 Vector solve_potential(const detail::ShellMesh& mesh, const std::vector<char>& kind) {
-  return detail::solve_dirichlet(mesh.vertices.rows(), mesh.tetrahedra, kind, [&](Index t) {
-    Eigen::Matrix<double, 4, 3> g;
-    const double volume = std::abs(detail::tetrahedron_gradients(mesh.vertices, mesh.tetrahedra, t, g));
-    return Eigen::Matrix4d(volume * g * g.transpose());
-  }, true);
+  return detail::solve_dirichlet(
+      mesh.vertices.rows(), mesh.tetrahedra, kind,
+      [&](Index t) {
+        Eigen::Matrix<double, 4, 3> g;
+        const double volume = std::abs(detail::tetrahedron_gradients(mesh.vertices, mesh.tetrahedra, t, g));
+        return Eigen::Matrix4d(volume * g * g.transpose());
+      },
+      true);
 }
 
 // Follows -grad c from the source boundary of the mesh to its target boundary. As in 2D, the P1
@@ -315,7 +318,7 @@ class Tracer {
   const Vector& c_;
   std::vector<Vec3> velocity_;      // recovered -grad c at the vertices
   std::vector<Vec3> element_flow_;  // -grad c of the tetrahedra at a crossing curve, else NaN
-  std::vector<double> step_;    // RK4 step length in each tetrahedron
+  std::vector<double> step_;        // RK4 step length in each tetrahedron
 };
 
 // The source cleared of its contact with the target (contact3d.hpp), and how it then lies
@@ -382,14 +385,15 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
   }
   const SurfaceIndex target_index(target_vertices, target_faces);
   const double finer_edge = std::min(source.mean_edge, target.mean_edge);
-  const Cleared cleared_pair = clear_and_classify(source_vertices, source_out, target_vertices, target_out,
-                                                  target_index, finer_edge, nesting);
+  const Cleared cleared_pair =
+      clear_and_classify(source_vertices, source_out, target_vertices, target_out, target_index, finer_edge, nesting);
   const detail::ClearedSource& cleared = cleared_pair.source;
   nesting = cleared_pair.nesting;
   // Bodies that only touch from outside count as crossing until the contact is cleared.
   if (nesting == detail::Nesting::disjoint) {
-    throw InvalidInput("s2: only touches s1 from outside (the surfaces neither cross nor enclose one another); "
-                       "diffusion mapping needs surfaces that overlap");
+    throw InvalidInput(
+        "s2: only touches s1 from outside (the surfaces neither cross nor enclose one another); "
+        "diffusion mapping needs surfaces that overlap");
   }
   // From here on the source is the cleared one: it bounds the region that is meshed and solved.
   const Points3& source_region = cleared.vertices;
@@ -430,8 +434,8 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
   // the crossing curves and their facets must follow the surfaces closely (at 0.2 the round trip
   // of the crossing pair grew from 2.4e-3 to 6.0e-3 RMS, and ends near the curve fell on the
   // wrong side).
-  criteria.facet_distance = (crossing ? kFacetDistanceCrossing : kFacetDistanceNested) *
-                            std::min(criteria.source_size, criteria.target_size);
+  criteria.facet_distance =
+      (crossing ? kFacetDistanceCrossing : kFacetDistanceNested) * std::min(criteria.source_size, criteria.target_size);
   // In a child process (see mesh_in_child.hpp); after a crash, again with other random choices
   // and sizes a little finer (the crashes come and go with both).
   detail::ShellMesh mesh;
@@ -516,7 +520,8 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
     Points3 queries(static_cast<Index>(reached.size()), 3);
     for (std::size_t k = 0; k < reached.size(); ++k) queries.row(static_cast<Index>(k)) = exits.row(reached[k]);
     const SurfaceHits ends = target_index.closest_points(queries);
-    for (std::size_t k = 0; k < reached.size(); ++k) solution.ends.row(reached[k]) = ends.points.row(static_cast<Index>(k));
+    for (std::size_t k = 0; k < reached.size(); ++k)
+      solution.ends.row(reached[k]) = ends.points.row(static_cast<Index>(k));
   }
   // Where the surfaces touch, the vertices map to their closest point (as 2D's contact stretches).
   solution.touching.assign(cleared.touching.begin(), cleared.touching.end());

@@ -15,18 +15,18 @@
 #include <CGAL/Mesh_complex_3_in_triangulation_3.h>
 #include <CGAL/Mesh_criteria_3.h>
 #include <CGAL/Mesh_triangulation_3.h>
+#include <CGAL/Orthogonal_k_neighbor_search.h>
 #include <CGAL/Polygon_mesh_processing/connected_components.h>
 #include <CGAL/Polygon_mesh_processing/corefinement.h>
 #include <CGAL/Polygon_mesh_processing/intersection.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
-#include <CGAL/make_mesh_3.h>
 #include <CGAL/Polyhedral_complex_mesh_domain_3.h>
-#include <CGAL/Orthogonal_k_neighbor_search.h>
 #include <CGAL/Random.h>
 #include <CGAL/Search_traits_3.h>
 #include <CGAL/Side_of_triangle_mesh.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/boost/graph/properties_Surface_mesh_features.h>
+#include <CGAL/make_mesh_3.h>
 #include <CGAL/refine_mesh_3.h>
 #include <tbb/parallel_for.h>
 
@@ -195,7 +195,8 @@ std::vector<char> inside_surface(const Points3Ref& vertices, const FacesRef& fac
     const SurfaceMesh surface = to_surface_mesh(vertices, faces);
     const CGAL::Side_of_triangle_mesh<SurfaceMesh, Kernel> side(surface);
     for (Index i = 0; i < queries.rows(); ++i) {
-      inside[static_cast<std::size_t>(i)] = side(Point(queries(i, 0), queries(i, 1), queries(i, 2))) != CGAL::ON_UNBOUNDED_SIDE;
+      inside[static_cast<std::size_t>(i)] =
+          side(Point(queries(i, 0), queries(i, 1), queries(i, 2))) != CGAL::ON_UNBOUNDED_SIDE;
     }
   } catch (const CGAL::Failure_exception& e) {
     throw GeometryError(std::string("locating points against a surface failed: ") + e.what());
@@ -203,9 +204,8 @@ std::vector<char> inside_surface(const Points3Ref& vertices, const FacesRef& fac
   return inside;
 }
 
-ShellMesh mesh_shell(const Points3Ref& source_vertices, const FacesRef& source_faces,
-                     const Points3Ref& target_vertices, const FacesRef& target_faces, bool source_inside,
-                     const ShellMeshCriteria& criteria) {
+ShellMesh mesh_shell(const Points3Ref& source_vertices, const FacesRef& source_faces, const Points3Ref& target_vertices,
+                     const FacesRef& target_faces, bool source_inside, const ShellMeshCriteria& criteria) {
   C3t3 c3t3;
   try {
     std::vector<SurfaceMesh> patches{to_surface_mesh(source_vertices, source_faces),
@@ -218,8 +218,8 @@ ShellMesh mesh_shell(const Points3Ref& source_vertices, const FacesRef& source_f
     const Domain domain(patches.begin(), patches.end(), sides, sides + 2, &random);
     namespace params = CGAL::parameters;
     const Criteria mesh_criteria(params::facet_angle = 25.0, params::facet_size = sizing,
-                                 params::facet_distance = criteria.facet_distance,
-                                 params::cell_radius_edge_ratio = 3.0, params::cell_size = sizing);
+                                 params::facet_distance = criteria.facet_distance, params::cell_radius_edge_ratio = 3.0,
+                                 params::cell_size = sizing);
     // Mesh_3's own initial points come from rays shot from the centre of the bounding box and may
     // all land on the outer surface, so that the inner one is never found: start instead from a
     // few vertices of each surface, as points of its patch.
@@ -239,12 +239,12 @@ ShellMesh mesh_shell(const Points3Ref& source_vertices, const FacesRef& source_f
 // Each patch: a connected piece of one surface between the curves where the surfaces cross,
 // oriented outwards of its surface.
 struct CrossingRegion::Patches {
-  SurfaceMesh source, target;        // the whole surfaces (for the sizing field)
-  std::vector<SurfaceMesh> meshes;   // the patches
-  std::vector<char> from_source;     // the patch is part of S1 (else of S2)
-  std::vector<char> inside_other;    // it lies inside the other surface
-  std::vector<char> has_border;      // it ends at a crossing curve (a patch without one is a
-                                     // whole component of a surface that the other does not cut)
+  SurfaceMesh source, target;       // the whole surfaces (for the sizing field)
+  std::vector<SurfaceMesh> meshes;  // the patches
+  std::vector<char> from_source;    // the patch is part of S1 (else of S2)
+  std::vector<char> inside_other;   // it lies inside the other surface
+  std::vector<char> has_border;     // it ends at a crossing curve (a patch without one is a
+                                    // whole component of a surface that the other does not cut)
   double volume = 0.0;
 };
 
@@ -367,8 +367,7 @@ ShellMesh CrossingRegion::mesh(const ShellMeshCriteria& criteria) const {
     const Criteria coarse(params::edge_size = sizing, params::facet_angle = 25.0,
                           params::facet_size = criteria.cell_size, params::cell_radius_edge_ratio = 3.0,
                           params::cell_size = criteria.cell_size);
-    c3t3 = CGAL::make_mesh_3<C3t3>(domain, coarse, params::features(domain), params::no_perturb(),
-                                   params::no_exude());
+    c3t3 = CGAL::make_mesh_3<C3t3>(domain, coarse, params::features(domain), params::no_perturb(), params::no_exude());
     for (std::size_t k = 0; k < p.meshes.size(); ++k) {
       if (!p.has_border[k]) seed_patch(c3t3, domain, p.meshes[k], static_cast<int>(k) + 1);
     }
