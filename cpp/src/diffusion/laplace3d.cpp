@@ -5,12 +5,14 @@
 #include <morphomap/laplace3d.hpp>
 #include <morphomap/surface_queries.hpp>
 
+#include "common/finite_rows.hpp"
 #include "common/interrupt_check.hpp"
 #include "common/numbers.hpp"
 #include "common/validation.hpp"
 #include "diffusion/contact3d.hpp"
 #include "diffusion/dirichlet.hpp"
 #include "diffusion/mesh_in_child.hpp"
+#include "diffusion/shell_diffusion.hpp"
 #include "diffusion/shell_mesh.hpp"
 
 #include <tbb/parallel_for.h>
@@ -364,6 +366,13 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, const FacesRef& source_faces,
                                           const Points3Ref& target_vertices, const FacesRef& target_faces,
                                           const ShellDiffusionOptions& options) {
+  return detail::solve_diffusion_3d(source_vertices, source_faces, target_vertices, target_faces, options, nullptr);
+}
+
+ShellDiffusionSolution detail::solve_diffusion_3d(const Points3Ref& source_vertices, const FacesRef& source_faces,
+                                                  const Points3Ref& target_vertices, const FacesRef& target_faces,
+                                                  const ShellDiffusionOptions& options,
+                                                  const SurfaceIndex* given_target_index) {
   if (!(options.mesh_size >= 0.0) || !std::isfinite(options.mesh_size)) {
     detail::invalid("mesh_size", "must be a finite length >= 0");
   }
@@ -383,7 +392,10 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
   if (nesting == detail::Nesting::disjoint) {
     throw InvalidInput("s2: diffusion mapping needs surfaces that overlap (these lie apart)");
   }
-  const SurfaceIndex target_index(target_vertices, target_faces);
+  std::unique_ptr<const SurfaceIndex> own_target_index;
+  if (given_target_index == nullptr)
+    own_target_index = std::make_unique<const SurfaceIndex>(target_vertices, target_faces);
+  const SurfaceIndex& target_index = given_target_index ? *given_target_index : *own_target_index;
   const double finer_edge = std::min(source.mean_edge, target.mean_edge);
   const Cleared cleared_pair =
       clear_and_classify(source_vertices, source_out, target_vertices, target_out, target_index, finer_edge, nesting);
@@ -511,15 +523,10 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
   });
 
   // The exit points lie on the mesh's approximation of the target: move them onto the surface.
-  std::vector<Index> reached;
-  for (Index i = 0; i < ns; ++i) {
-    if (exits.row(i).allFinite()) reached.push_back(i);
-  }
+  const std::vector<Index> reached = detail::finite_rows(exits);
   solution.ends = Points3::Constant(ns, 3, kNaN);
   if (!reached.empty()) {
-    Points3 queries(static_cast<Index>(reached.size()), 3);
-    for (std::size_t k = 0; k < reached.size(); ++k) queries.row(static_cast<Index>(k)) = exits.row(reached[k]);
-    const SurfaceHits ends = target_index.closest_points(queries);
+    const SurfaceHits ends = target_index.closest_points(exits(reached, Eigen::all));
     for (std::size_t k = 0; k < reached.size(); ++k)
       solution.ends.row(reached[k]) = ends.points.row(static_cast<Index>(k));
   }

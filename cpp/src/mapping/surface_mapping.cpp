@@ -5,9 +5,8 @@
 #include <morphomap/surface_mapping.hpp>
 #include <morphomap/surface_queries.hpp>
 
-#include "common/finite_rows.hpp"
-#include "common/numbers.hpp"
 #include "common/validation.hpp"
+#include "diffusion/shell_diffusion.hpp"
 #include "diffusion/shell_mesh.hpp"
 #include "quality/folds.hpp"
 
@@ -20,8 +19,6 @@
 #include <vector>
 
 namespace morphomap {
-
-using detail::kNaN;
 
 namespace {
 
@@ -53,16 +50,11 @@ DisplacementField3 basic(MapMethod method, const Surface& source, const Surface&
     case MapMethod::diffusion: {
       ShellDiffusionOptions options;
       options.mesh_size = mesh_size;
-      const ShellDiffusionSolution solution =
-          solve_diffusion_3d(source.vertices, source.faces, target.vertices, target.faces, options);
+      const ShellDiffusionSolution solution = detail::solve_diffusion_3d(source.vertices, source.faces, target.vertices,
+                                                                         target.faces, options, &target_index);
       if (solution.ends.rows() != field.size())
         throw GeometryError("diffusion: the solver returned the wrong number of ends");
-      // The tetrahedral mesh only approximates the target: put each end onto the target itself.
-      field.ends = solution.ends;
-      const std::vector<Index> rows = detail::finite_rows(field.ends);
-      const Points3 found = field.ends(rows, Eigen::all);
-      const Points3 on_target = target_index.closest_points(found).points;
-      for (std::size_t k = 0; k < rows.size(); ++k) field.ends.row(rows[k]) = on_target.row(k);
+      field.ends = solution.ends;  // on the target itself (solve_diffusion_3d puts them there)
       // The streamlines do not cross; the few slivers their discrete form flips are repaired.
       std::unique_ptr<SurfaceIndex> own_index;
       if (source_index == nullptr) {
