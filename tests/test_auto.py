@@ -59,7 +59,7 @@ def test_density_rule_tries_reverse_minimal_distance_on_dense_points():
 def test_density_threshold_is_checked():
     import pytest
 
-    with pytest.raises(ValueError, match="density_threshold: must be a finite number > 0"):
+    with pytest.raises(ValueError, match="density_threshold: must be a finite number >= 0"):
         mm.map_curves(circle(10), circle(10, 2.0), density_threshold=-1.0)
     with pytest.raises(TypeError, match="density_threshold: expected a number"):
         mm.map_curves(circle(10), circle(10, 2.0), density_threshold="high")

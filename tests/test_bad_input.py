@@ -134,7 +134,7 @@ def test_flags_and_counts_are_checked():
         mm.perimeter(SQUARE, closed="yes")
     with pytest.raises(TypeError, match="n: expected an integer"):
         mm.resample(SQUARE, 10.5)
-    with pytest.raises(ValueError, match="n: must be at least 3"):
+    with pytest.raises(ValueError, match="n: resampling a closed curve needs at least 3"):
         mm.resample(SQUARE, 2)
     with pytest.raises(ValueError, match="method: expected one of"):
         mm.resample(SQUARE, 10, method="cubic")

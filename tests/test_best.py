@@ -168,7 +168,7 @@ def test_bad_input():
     with pytest.raises(ValueError, match="stretch_weight"):
         mm.map_curves(c1, c2, "best", stretch_weight=-1.0)
     with pytest.raises(ValueError, match="density_threshold"):
-        mm.map_curves(c1, c2, "best", density_threshold=0.0)
+        mm.map_curves(c1, c2, "best", density_threshold=-1.0)
 
 
 def wavy_pair():

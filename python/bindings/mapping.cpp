@@ -27,6 +27,26 @@ MapMethod map_method(const std::string& name) {
       "method: expected 'auto', 'minimal_distance', 'normal', 'diffusion', 'uniform' or 'optimal', got '" + name + "'");
 }
 
+CurveMappingOptions curve_mapping_options(const std::string& method, bool closed, Index n, bool reverse, bool transform,
+                                          bool split, std::optional<Vec2> anchor, double density_threshold,
+                                          double contact_tolerance, double mesh_size, double mesh_fraction,
+                                          double stretch_weight) {
+  CurveMappingOptions options;
+  options.method = map_method(method);
+  options.closed = closed;
+  options.n = n;
+  options.reverse = reverse;
+  options.transform = transform;
+  options.split = split;
+  options.anchor = anchor;
+  options.density_threshold = density_threshold;
+  options.contact_tolerance = contact_tolerance;
+  options.diffusion.mesh_size = mesh_size;
+  options.diffusion.mesh_fraction = mesh_fraction;
+  options.stretch_weight = stretch_weight;
+  return options;
+}
+
 }  // namespace
 
 void bind_mapping(py::module_& m) {
@@ -35,19 +55,9 @@ void bind_mapping(py::module_& m) {
       [](const Points2Ref& c1, const Points2Ref& c2, const std::string& method, bool closed, Index n, bool reverse,
          bool transform, bool split, std::optional<Vec2> anchor, double density_threshold, double contact_tolerance,
          double mesh_size, double mesh_fraction, double stretch_weight) {
-        CurveMappingOptions options;
-        options.method = map_method(method);
-        options.closed = closed;
-        options.n = n;
-        options.reverse = reverse;
-        options.transform = transform;
-        options.split = split;
-        options.anchor = anchor;
-        options.density_threshold = density_threshold;
-        options.contact_tolerance = contact_tolerance;
-        options.diffusion.mesh_size = mesh_size;
-        options.diffusion.mesh_fraction = mesh_fraction;
-        options.stretch_weight = stretch_weight;
+        const CurveMappingOptions options =
+            curve_mapping_options(method, closed, n, reverse, transform, split, anchor, density_threshold,
+                                  contact_tolerance, mesh_size, mesh_fraction, stretch_weight);
         DisplacementField2 field;
         InterruptGuard interruptible;
         {
@@ -60,6 +70,16 @@ void bind_mapping(py::module_& m) {
       py::arg("transform"), py::arg("split"), py::arg("anchor"), py::arg("density_threshold"),
       py::arg("contact_tolerance"), py::arg("mesh_size"), py::arg("mesh_fraction"),
       py::arg("stretch_weight") = kDefaultStretchWeight);
+  // map_curves' checks of its options alone (method "best" makes them before running candidates).
+  m.def(
+      "validate_options",
+      [](bool closed, Index n, std::optional<Vec2> anchor, double density_threshold, double contact_tolerance,
+         double mesh_size, double mesh_fraction, double stretch_weight) {
+        validate_options(curve_mapping_options("auto", closed, n, false, false, true, anchor, density_threshold,
+                                               contact_tolerance, mesh_size, mesh_fraction, stretch_weight));
+      },
+      py::arg("closed"), py::arg("n"), py::arg("anchor"), py::arg("density_threshold"), py::arg("contact_tolerance"),
+      py::arg("mesh_size"), py::arg("mesh_fraction"), py::arg("stretch_weight"));
   m.attr("DEFAULT_STRETCH_WEIGHT") = kDefaultStretchWeight;
 
   py::class_<CurvePiece>(m, "CurvePiece")

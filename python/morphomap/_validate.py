@@ -1,8 +1,10 @@
-"""Argument checks shared by the public functions.
+"""Argument conversion shared by the public functions.
 
 Every array goes to the C++ core as a float64, C-contiguous copy or view, so the core can take it
 without copying. Errors name the argument: ``TypeError`` for a wrong kind of object, ``ValueError``
-for a wrong shape or value.
+for a wrong shape or value. Where the C++ core checks a value (the options of the mappings, the
+diffusion and the extension), Python only converts it (``as_real``, ``as_integer``) and the
+core's message is the one users see; the rules here are for values that never reach the core.
 """
 
 from __future__ import annotations
@@ -34,6 +36,26 @@ def as_points(value, name: str, dim: int = 2, *, allow_nan: bool = False) -> np.
     return array
 
 
+def as_real(value, name: str, default: float) -> float:
+    """``value`` as a float (``default`` for None) for the C++ core to check; TypeError for a
+    non-number."""
+    if value is None:
+        return default
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name}: expected a number, got {type(value).__name__}")
+    return float(value)
+
+
+def as_integer(value, name: str, default: int) -> int:
+    """``value`` as an int (``default`` for None) for the C++ core to check; TypeError for a
+    non-integer."""
+    if value is None:
+        return default
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{name}: expected an integer, got {type(value).__name__}")
+    return int(value)
+
+
 def as_count(value, name: str, minimum: int) -> int:
     """Return ``value`` as a Python int of at least ``minimum``."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
@@ -60,14 +82,15 @@ def as_choice(value, name: str, choices: tuple[str, ...]) -> str:
     return value
 
 
-def as_point(value, name: str, dim: int = 2) -> np.ndarray:
-    """Return one point given as a sequence of ``dim`` finite numbers as a float64 ``(dim,)`` array."""
+def as_point(value, name: str, dim: int = 2, *, allow_nan: bool = False) -> np.ndarray:
+    """Return one point given as a sequence of ``dim`` numbers (finite unless ``allow_nan``) as a
+    float64 ``(dim,)`` array."""
     if isinstance(value, (str, bytes)):
         raise TypeError(f"{name}: expected {dim} coordinates, got {type(value).__name__}")
     array = np.asarray(value)
     if array.shape != (dim,):
         raise ValueError(f"{name}: expected {dim} coordinates, got shape {array.shape}")
-    return as_points(array.reshape(1, dim), name, dim)[0]
+    return as_points(array.reshape(1, dim), name, dim, allow_nan=allow_nan)[0]
 
 
 def as_length(value, name: str, default: float, *, allow_zero: bool = False) -> float:

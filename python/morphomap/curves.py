@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import _core
-from ._validate import as_choice, as_count, as_flag, as_points
+from ._validate import as_choice, as_flag, as_integer, as_points
 
 RESAMPLE_METHODS = ("linear", "spline", "pchip")
 
@@ -38,7 +38,7 @@ def resample(points, n, *, closed=True, method="linear") -> np.ndarray:
     """
     closed = as_flag(closed, "closed")
     method = as_choice(method, "method", RESAMPLE_METHODS)
-    n = as_count(n, "n", 3 if closed else 2)
+    n = as_integer(n, "n", 0)  # the core checks the count
     return _core.resample(as_points(points, "points"), n, closed, method)
 
 

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _core
-from ._validate import as_flag, as_length, as_points
+from ._validate import as_flag, as_points, as_real
 
 
 @dataclass(frozen=True)
@@ -53,7 +53,7 @@ def solve_diffusion(c1, c2, *, closed=True, mesh_size=None, mesh_fraction=0.02, 
     """
     found = _core.solve_diffusion(
         as_points(c1, "c1"), as_points(c2, "c2"), as_flag(closed, "closed"),
-        as_length(mesh_size, "mesh_size", 0.0), as_length(mesh_fraction, "mesh_fraction", 0.02),
+        as_real(mesh_size, "mesh_size", 0.0), as_real(mesh_fraction, "mesh_fraction", 0.02),
         as_flag(streamlines, "streamlines"))
     return DiffusionSolution(found["vertices"], found["triangles"], found["potential"], found["ends"],
                              list(found["streamlines"]), dict(found["seconds"]))

@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-import numbers
 import sys
 from dataclasses import dataclass
 
 import numpy as np
 
 from . import _core
-from ._validate import as_flag
+from ._validate import as_flag, as_real
 from .surfaces import as_surface
 
 
@@ -40,17 +39,6 @@ class ShellDiffusionSolution:
     touching: np.ndarray
     streamlines: list
     seconds: dict
-
-
-def _mesh_size(value):
-    if value is None:
-        return 0.0
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise TypeError(f"mesh_size: expected a number, got {type(value).__name__}")
-    value = float(value)
-    if not np.isfinite(value) or value <= 0:
-        raise ValueError(f"mesh_size: must be a finite number > 0, got {value}")
-    return value
 
 
 class _StageBar:
@@ -124,7 +112,7 @@ def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False, progress=No
     """
     v1, f1 = as_surface(s1, "s1")
     v2, f2 = as_surface(s2, "s2")
-    size, keep = _mesh_size(mesh_size), as_flag(streamlines, "streamlines")
+    size, keep = as_real(mesh_size, "mesh_size", 0.0), as_flag(streamlines, "streamlines")
     bar = _StageBar(progress)
     try:
         solved = _core.solve_diffusion_3d(v1, f1, v2, f2, size, keep, bar.on_stage if bar.bar is not None else None)

@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import numbers
 
 import numpy as np
 
 from . import _core
-from ._validate import as_choice, as_count, as_flag, as_length, as_points
+from ._validate import as_choice, as_flag, as_integer, as_length, as_points, as_real
 from .field import DisplacementField
 
 EXTENSION_METHODS = ("harmonic", "elastic")
@@ -60,15 +59,6 @@ class InteriorField:
         kind = "triangles" if self.dim == 2 else "tetrahedra"
         return (f"InteriorField({len(self.points)} nodes, {len(self.cells)} {kind}, {self.inverted} inverted, "
                 f"min jacobian {self.min_jacobian:.3g})")
-
-
-def _poisson_ratio(value) -> float:
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
-        raise TypeError(f"poisson_ratio: expected a number, got {type(value).__name__}")
-    value = float(value)
-    if not 0.0 <= value < 0.5:
-        raise ValueError(f"poisson_ratio: must be at least 0 and below 0.5, got {value}")
-    return value
 
 
 def extend_field(field, boundary=None, *, method="harmonic", mesh=None, mesh_size=None, poisson_ratio=0.3,
@@ -124,8 +114,9 @@ def extend_field(field, boundary=None, *, method="harmonic", mesh=None, mesh_siz
     if not isinstance(field, DisplacementField):
         raise TypeError(f"field: expected a DisplacementField, got {type(field).__name__}")
     as_choice(method, "method", EXTENSION_METHODS)
-    options = dict(method=method, poisson_ratio=_poisson_ratio(poisson_ratio),
-                   substeps=as_count(substeps, "substeps", 1), untangle=as_flag(untangle, "untangle"))
+    # Types here; the core checks the values (its messages are the ones users see).
+    options = dict(method=method, poisson_ratio=as_real(poisson_ratio, "poisson_ratio", 0.3),
+                   substeps=as_integer(substeps, "substeps", 1), untangle=as_flag(untangle, "untangle"))
     if mesh is not None:
         if not (isinstance(mesh, (tuple, list)) and len(mesh) == 2):
             raise TypeError("mesh: expected a (points, cells) pair")
@@ -141,7 +132,7 @@ def extend_field(field, boundary=None, *, method="harmonic", mesh=None, mesh_siz
         if mesh is None:
             points, cells = np.zeros((0, 3)), np.zeros((0, 4), dtype=np.int64)
         result = _core.extend_field_3d(field.starts, field.ends, field.faces, points, cells,
-                                       mesh_size=as_length(mesh_size, "mesh_size", 0.0), **options)
+                                       mesh_size=as_real(mesh_size, "mesh_size", 0.0), **options)
     else:
         source = field.source if boundary is None else boundary
         if source is None:
@@ -149,5 +140,5 @@ def extend_field(field, boundary=None, *, method="harmonic", mesh=None, mesh_siz
         if mesh is None:
             points, cells = np.zeros((0, 2)), np.zeros((0, 3), dtype=np.int64)
         result = _core.extend_field_2d(field.starts, field.ends, as_points(source, "boundary", 2), points, cells,
-                                       mesh_size=as_length(mesh_size, "mesh_size", 0.0), **options)
+                                       mesh_size=as_real(mesh_size, "mesh_size", 0.0), **options)
     return InteriorField(**result)

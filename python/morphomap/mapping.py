@@ -2,25 +2,29 @@
 
 from __future__ import annotations
 
-import numbers
 
-import numpy as np
 
 from . import _core
-from ._validate import as_choice, as_count, as_flag, as_length, as_point, as_points
+from ._validate import as_choice, as_flag, as_integer, as_length, as_point, as_points, as_real
 from .field import DisplacementField
 
 CURVE_METHODS = ("auto", "minimal_distance", "normal", "diffusion", "uniform", "optimal", "best")
 
 
-def _threshold(value) -> float:
-    if value is None:
-        return 0.0
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise TypeError(f"density_threshold: expected a number, got {type(value).__name__}")
-    if not np.isfinite(value) or value <= 0:
-        raise ValueError(f"density_threshold: must be a finite number > 0, got {value}")
-    return float(value)
+def _core_options(n, anchor, density_threshold, contact_tolerance, mesh_size, mesh_fraction, stretch_weight):
+    """The options as the core takes them. Only their types are checked here: the core checks the
+    values (``validate_options`` in ``morphomap/mapping.hpp``) and its messages are the ones users
+    see. The one rule of Python's own: ``contact_tolerance`` None is the core's default (any
+    negative number there), so a negative number passed here is refused rather than read as it."""
+    return dict(
+        n=as_integer(n, "n", 0),
+        anchor=None if anchor is None else as_point(anchor, "anchor", allow_nan=True),
+        density_threshold=as_real(density_threshold, "density_threshold", 0.0),
+        contact_tolerance=as_length(contact_tolerance, "contact_tolerance", -1.0, allow_zero=True),
+        mesh_size=as_real(mesh_size, "mesh_size", 0.0),
+        mesh_fraction=as_real(mesh_fraction, "mesh_fraction", 0.02),
+        stretch_weight=as_real(stretch_weight, "stretch_weight", _core.DEFAULT_STRETCH_WEIGHT),
+    )
 
 
 def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, transform=False,
@@ -131,29 +135,16 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
             raise ValueError("reverse/transform: method 'best' tries the reversed and transformed forms itself; "
                              "leave both False")
         # Checked here, as a candidate that refuses an option would only drop out of the choice.
-        _threshold(density_threshold)
-        as_length(stretch_weight, "stretch_weight", _core.DEFAULT_STRETCH_WEIGHT, allow_zero=True)
-        as_length(contact_tolerance, "contact_tolerance", -1.0, allow_zero=True)
-        as_length(mesh_size, "mesh_size", 0.0)
-        as_length(mesh_fraction, "mesh_fraction", 0.02)
-        if n is not None:
-            as_count(n, "n", 3 if closed else 2)
-        if anchor is not None:
-            as_point(anchor, "anchor")
+        _core.validate_options(closed, **_core_options(n, anchor, density_threshold, contact_tolerance, mesh_size,
+                                                        mesh_fraction, stretch_weight))
         return map_best(c1, c2, closed=closed, n=n, split=split, anchor=anchor,
                         density_threshold=density_threshold, contact_tolerance=contact_tolerance,
                         mesh_size=mesh_size, mesh_fraction=mesh_fraction, stretch_weight=stretch_weight,
                         skip_below=skip_below, workers=workers)
     if skip_below is not None or workers is not None:
         raise ValueError("skip_below/workers: only for method 'best'")
-    count = 0 if n is None else as_count(n, "n", 3 if closed else 2)
-    if anchor is not None:
-        anchor = as_point(anchor, "anchor")
+    options = _core_options(n, anchor, density_threshold, contact_tolerance, mesh_size, mesh_fraction, stretch_weight)
     c1 = as_points(c1, "c1")
-    record = _core.map_curves(
-        c1, as_points(c2, "c2"), method, closed, count,
-        as_flag(reverse, "reverse"), as_flag(transform, "transform"), as_flag(split, "split"), anchor,
-        _threshold(density_threshold), as_length(contact_tolerance, "contact_tolerance", -1.0, allow_zero=True),
-        as_length(mesh_size, "mesh_size", 0.0), as_length(mesh_fraction, "mesh_fraction", 0.02),
-        as_length(stretch_weight, "stretch_weight", _core.DEFAULT_STRETCH_WEIGHT, allow_zero=True))
+    record = _core.map_curves(c1, as_points(c2, "c2"), method, closed, reverse=as_flag(reverse, "reverse"),
+                              transform=as_flag(transform, "transform"), split=as_flag(split, "split"), **options)
     return DisplacementField._from_core(record, source=c1, closed=closed)

@@ -7,7 +7,7 @@ from typing import NamedTuple
 import numpy as np
 
 from . import _core
-from ._validate import as_choice, as_faces, as_flag, as_length, as_points
+from ._validate import as_choice, as_faces, as_flag, as_points, as_real
 from .field import DisplacementField
 
 SURFACE_METHODS = ("minimal_distance", "normal", "diffusion", "auto", "best")
@@ -140,5 +140,5 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None, skip
         raise ValueError("skip_below/workers: only for method 'best'")
     v1, f1 = as_surface(s1, "s1")
     v2, f2 = as_surface(s2, "s2")
-    record = _core.map_surfaces(v1, f1, v2, f2, method, reverse, as_length(mesh_size, "mesh_size", 0.0))
+    record = _core.map_surfaces(v1, f1, v2, f2, method, reverse, as_real(mesh_size, "mesh_size", 0.0))
     return DisplacementField._from_core(record)

@@ -41,7 +41,7 @@ struct ExtendOptions {
   // sweeps until none is inverted or nothing moves). Those nodes' displacement is then no longer
   // the method's solution; cells with all corners on the boundary cannot be untangled this way.
   bool untangle = false;
-  // No mesh given: the largest edge of the mesh made (<= 0: graded from the boundary's spacing).
+  // No mesh given: the largest edge of the mesh made (0: graded from the boundary's spacing); >= 0.
   double mesh_size = 0.0;
   int seed = 0;  // 3D without a mesh: of Mesh_3's random choices (the same seed, the same mesh)
 };
@@ -52,7 +52,7 @@ struct ExtendOptions {
 // inside it solves the method's equations (P1 finite elements, multifrontal sparse Cholesky in 2D, conjugate
 // gradients first in 3D). Either method extends an affine boundary map to the same affine map.
 // 2D, mesh_cells empty: the region C1 encloses is meshed with CGAL's constrained Delaunay mesher,
-// every point of C1 a node, edges at most mesh_size (<= 0: graded from C1's point spacing).
+// every point of C1 a node, edges at most mesh_size (0: graded from C1's point spacing).
 // 3D, mesh_cells empty: the region the start triangles enclose (a closed surface) is meshed with
 // CGAL's Mesh_3 (its surface nodes lie on the triangles; a tetrahedron with all four corners on
 // them, which would move with the boundary field alone, gets a node inside by a split of its

@@ -48,6 +48,10 @@ struct CurveMappingOptions {
 // curves cut their corners).
 DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2, const CurveMappingOptions& options = {});
 
+// The checks of the options that map_curves makes (after the curves', before any work):
+// InvalidInput naming the option. For callers that run several mappings with one set of options.
+void validate_options(const CurveMappingOptions& options);
+
 // One subproblem of a pair: the stretch of C1 between two consecutive split points (crossings when
 // splitting, contact stretches always; or an end of open curves) and the stretch of C2 between
 // the same two, as open polylines: source runs from the first split point through the vertices of

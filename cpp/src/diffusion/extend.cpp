@@ -235,7 +235,9 @@ void require_options(const ExtendOptions& options) {
     detail::invalid("poisson_ratio", "must be at least 0 and below 0.5, got " + std::to_string(options.poisson_ratio));
   }
   if (options.substeps < 1) detail::invalid("substeps", "must be at least 1, got " + std::to_string(options.substeps));
-  if (!std::isfinite(options.mesh_size)) detail::invalid("mesh_size", "must be finite");
+  if (!(options.mesh_size >= 0.0) || !std::isfinite(options.mesh_size)) {
+    detail::invalid("mesh_size", "must be a finite length >= 0 (0: automatic)");
+  }
 }
 
 // The mesh size for Mesh_3: the one asked for, else the start triangles' mean edge (checking that

@@ -681,10 +681,8 @@ void project_onto(Points2& points, const Points2Ref& curve, bool closed) {
 
 }  // namespace
 
-DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2, const CurveMappingOptions& options) {
+void validate_options(const CurveMappingOptions& options) {
   const bool closed = options.closed;
-  const Index n1 = detail::require_simple_curve(c1, closed, "c1");
-  const Index n2 = detail::require_simple_curve(c2, closed, "c2");
   if (options.n < 0 || (options.n > 0 && options.n < (closed ? 3 : 2))) {
     detail::invalid("n", "must be 0 (use the given points) or at least " + std::string(closed ? "3" : "2") + ", got " +
                              std::to_string(options.n));
@@ -697,6 +695,16 @@ DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2, const 
   }
   detail::require_diffusion_options(options.diffusion);
   if (options.anchor && !options.anchor->allFinite()) detail::invalid("anchor", "has a non-finite coordinate");
+  if (!(options.stretch_weight >= 0.0) || !std::isfinite(options.stretch_weight)) {
+    detail::invalid("stretch_weight", "must be a finite number >= 0, got " + std::to_string(options.stretch_weight));
+  }
+}
+
+DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2, const CurveMappingOptions& options) {
+  const bool closed = options.closed;
+  const Index n1 = detail::require_simple_curve(c1, closed, "c1");
+  const Index n2 = detail::require_simple_curve(c2, closed, "c2");
+  validate_options(options);
   // Frames of one organ overlap; closed curves that neither cross nor nest are the wrong pair
   // (other units, another offset), whatever a method would make of them.
   // (Each curve's point farthest from the other decides: a touching point would not.)
