@@ -36,24 +36,24 @@ def as_points(value, name: str, dim: int = 2, *, allow_nan: bool = False) -> np.
     return array
 
 
+def _as_kind(value, name: str, default, kind, convert, what: str):
+    if value is None:
+        return default
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, kind):
+        raise TypeError(f"{name}: expected {what}, got {type(value).__name__}")
+    return convert(value)
+
+
 def as_real(value, name: str, default: float) -> float:
     """``value`` as a float (``default`` for None) for the C++ core to check; TypeError for a
     non-number."""
-    if value is None:
-        return default
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
-        raise TypeError(f"{name}: expected a number, got {type(value).__name__}")
-    return float(value)
+    return _as_kind(value, name, default, numbers.Real, float, "a number")
 
 
 def as_integer(value, name: str, default: int) -> int:
     """``value`` as an int (``default`` for None) for the C++ core to check; TypeError for a
     non-integer."""
-    if value is None:
-        return default
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
-        raise TypeError(f"{name}: expected an integer, got {type(value).__name__}")
-    return int(value)
+    return _as_kind(value, name, default, numbers.Integral, int, "an integer")
 
 
 def as_count(value, name: str, minimum: int) -> int:
