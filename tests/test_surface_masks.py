@@ -54,6 +54,26 @@ def test_a_ball_in_an_anisotropic_stack():
     assert 0.8 < np.median(lengths) / 1.0 < 1.25
 
 
+def test_an_object_cut_by_the_stack_border_is_closed_by_it():
+    # Cells cut by the field of view are common: a ball whose centre lies 2.25 um inside the
+    # stack's x = -0.25 face (the half voxel beyond the first column), unsmoothed and smoothed, at
+    # the default edge length (blocks of 2 x 2 voxels across x and y) and at 3 um (blocks of 3 x 3,
+    # whose first block held one voxel of padding and two of the object, 2/3 > 0.5, when the
+    # padding was one voxel: the surface was left open there). The surface closes along the border
+    # and encloses the ball minus the cap beyond it (the Gaussian rounds the rim a little).
+    r, d = 12.0, 2.25
+    centre = np.array([d - 0.25, 25.3, 25.0])
+    volume = ball((26, 100, 100), centre, r, SPACING)
+    assert volume[:, :, 0].any()  # it touches the border
+    for smooth, edge in ((0.0, None), (0.5, None), (0.0, 3.0), (0.5, 3.0)):
+        surface = mm.surface_from_mask(volume, SPACING, smooth=smooth, edge_length=edge)
+        assert surface.is_watertight and surface.volume > 0
+        cap = r - d
+        expected = 4 / 3 * np.pi * r**3 - np.pi * cap**2 * (3 * r - cap) / 3
+        assert abs(surface.volume / expected - 1) < 0.05, (smooth, edge, surface.volume, expected)
+        assert surface.vertices[:, 0].min() > -0.25 - 0.5  # no further than half a voxel beyond the cut
+
+
 def test_coordinates_follow_the_axes():
     # A box of voxels z 2..5, y 10..29, x 4..13 at (sz, sy, sx) = (2, 0.5, 1): x is the column.
     volume = np.zeros((8, 40, 20), bool)

@@ -135,7 +135,7 @@ def _block_mean(mask: np.ndarray, factors) -> np.ndarray:
         if f > 1:
             shape = counts.shape[:axis] + (counts.shape[axis] // f, f) + counts.shape[axis + 1:]
             counts = counts.reshape(shape).sum(axis=axis + 1, dtype=wide)
-    return counts.astype(np.float32) / np.prod(factors)
+    return counts.astype(np.float32) / np.float32(np.prod(factors))
 
 
 #: Rounds of isotropic remeshing: three bring the smallest angles above 20 degrees (bench/README.md).
@@ -189,20 +189,22 @@ def surface_from_mask(volume, spacing=(1.0, 1.0, 1.0), *, label=None, smooth=0.0
     sigma = as_length(smooth, "smooth", 0.0, allow_zero=True)
     edge = as_length(edge_length, "edge_length", max(step))
     _require_one_object(voxels, "volume")
-    # One voxel of padding closes the surface of an object touching the border; the Gaussian
-    # needs none (see boundary_from_mask).
-    pad = 1
-    padded = np.pad(voxels, pad)
+    # Triangles of edge `edge` cannot hold detail finer than edge / 2: contouring the image
+    # averaged over blocks of that size (anti-aliased) gives the remesher a few times fewer
+    # triangles to collapse, which is most of its work (bench/README.md).
+    factors = tuple(max(1, int(edge // (2 * h))) for h in step)
+    # One whole block of padding on each side closes the surface of an object touching the border:
+    # the outermost samples are then empty blocks (one voxel would share a block with the object
+    # and could average above 0.5). The Gaussian needs none (see boundary_from_mask).
+    pads = factors
+    padded = np.pad(voxels, [(f, f) for f in pads])
     # Cavities are the background not connected to the outside (the padded corner); labelling
     # finds them 4x faster than scipy's binary_fill_holes.
     background, _ = ndimage.label(~padded)
     filled = background != background[0, 0, 0]
     del background
-    # Triangles of edge `edge` cannot hold detail finer than edge / 2: contouring the image
-    # averaged over blocks of that size (anti-aliased) gives the remesher a few times fewer
-    # triangles to collapse, which is most of its work (bench/README.md). The Gaussian, a
-    # convolution like the block mean, runs after it on the blocks' grid: a few times fewer voxels.
-    factors = tuple(max(1, int(edge // (2 * h))) for h in step)
+    # The Gaussian, a convolution like the block mean, runs after it on the blocks' grid: a few
+    # times fewer voxels.
     image = _block_mean(filled, factors)
     grid = tuple(h * f for h, f in zip(step, factors))
     if sigma > 0:
@@ -212,7 +214,7 @@ def surface_from_mask(volume, spacing=(1.0, 1.0, 1.0), *, label=None, smooth=0.0
     vertices, faces, _, _ = measure.marching_cubes(image, 0.5, spacing=grid)
     # (z, y, x) -> (x, y, z); a block's sample sits at the centre of its voxels, and the padding is
     # taken off, so that coordinates are the volume's.
-    origin = np.array([((f - 1) / 2 - pad) * h for h, f in zip(step, factors)])
+    origin = np.array([((f - 1) / 2 - pad) * h for h, f, pad in zip(step, factors, pads)])
     vertices = np.ascontiguousarray((vertices + origin)[:, ::-1])
     faces = np.ascontiguousarray(faces, dtype=np.int64)
     try:
