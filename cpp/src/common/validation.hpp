@@ -14,6 +14,21 @@ namespace morphomap::detail {
 // Every coordinate finite.
 void require_finite(const Points2Ref& points, const char* name);
 
+// Lines origin + t * direction for a line query (2D or 3D; finiteness is checked by the caller):
+// as many directions as origins, none of them the zero vector.
+template <class PointsRef>
+void require_directions(const PointsRef& origins, const PointsRef& directions) {
+  if (origins.rows() != directions.rows()) {
+    invalid("directions",
+            "has " + std::to_string(directions.rows()) + " rows but origins has " + std::to_string(origins.rows()));
+  }
+  for (Index i = 0; i < directions.rows(); ++i) {
+    if (!(directions.row(i).cwiseAbs().maxCoeff() > 0)) {
+      invalid("directions", "row " + std::to_string(i) + " is the zero vector");
+    }
+  }
+}
+
 // Points that take part: a closed curve whose last point repeats its first drops the last.
 Index curve_size(const Points2Ref& points, bool closed);
 

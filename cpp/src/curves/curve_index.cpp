@@ -5,8 +5,6 @@
 #include "common/validation.hpp"
 #include "curves/curve_tree.hpp"
 
-#include <string>
-
 namespace morphomap {
 
 struct CurveIndex::Impl : curve_tree::Tree {
@@ -44,15 +42,7 @@ CurveHits CurveIndex::closest_points(const Points2Ref& queries) const {
 CurveHits CurveIndex::line_intersections(const Points2Ref& origins, const Points2Ref& directions) const {
   detail::require_finite(origins, "origins");
   detail::require_finite(directions, "directions");
-  if (origins.rows() != directions.rows()) {
-    detail::invalid("directions", "has " + std::to_string(directions.rows()) + " rows but origins has " +
-                                      std::to_string(origins.rows()));
-  }
-  for (Index i = 0; i < directions.rows(); ++i) {
-    if (directions(i, 0) == 0.0 && directions(i, 1) == 0.0) {
-      detail::invalid("directions", "row " + std::to_string(i) + " is the zero vector");
-    }
-  }
+  detail::require_directions(origins, directions);
   CurveHits hits = allocate_hits(origins.rows());
   impl_->line_intersections(origins, directions, hits);
   return hits;

@@ -409,15 +409,7 @@ SurfaceHits SurfaceIndex::closest_points(const Points3Ref& queries) const {
 SurfaceHits SurfaceIndex::line_intersections(const Points3Ref& origins, const Points3Ref& directions) const {
   detail::require_finite3(origins, "origins");
   detail::require_finite3(directions, "directions");
-  if (origins.rows() != directions.rows()) {
-    detail::invalid("directions", "has " + std::to_string(directions.rows()) + " rows but origins has " +
-                                      std::to_string(origins.rows()));
-  }
-  for (Index i = 0; i < directions.rows(); ++i) {
-    if (!(directions.row(i).cwiseAbs().maxCoeff() > 0)) {
-      detail::invalid("directions", "row " + std::to_string(i) + " is the zero vector");
-    }
-  }
+  detail::require_directions(origins, directions);
   SurfaceHits hits = allocate_hits(origins.rows());
   std::vector<std::uint32_t> order;
   if (impl_->faces.rows() >= kOrderFaces && origins.rows() >= kOrderLines && origins.rows() <= Index{UINT32_MAX}) {
