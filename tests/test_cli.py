@@ -1,8 +1,6 @@
 """The command line: `morphomap info`, `map`, `extend`, `series` and `batch` end to end."""
 
 import re
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -12,7 +10,9 @@ from conftest import morphomap
 
 
 def test_info_prints_versions_and_threads():
-    out = subprocess.run([sys.executable, "-m", "morphomap", "info"], capture_output=True, text=True, check=True).stdout
+    run = morphomap("info")
+    assert run.returncode == 0, run.stderr
+    out = run.stdout
     info = mm.build_info()
     assert f"morphomap {mm.__version__}" in out
     for key in ("cgal", "embree", "eigen", "tbb"):
@@ -101,27 +101,20 @@ def test_map_reads_masks(tmp_path):
         tifffile.imwrite(tmp_path / name, mask.astype(np.uint8), imagej=True, resolution=(2.0, 2.0),
                          metadata={"unit": "um"})
     out = tmp_path / "field.csv"
-    done = subprocess.run([sys.executable, "-m", "morphomap", "map", str(tmp_path / "t0.tif"), str(tmp_path / "t1.tif"),
-                           "--smooth", "0.5", "-o", str(out)], capture_output=True, text=True)
+    done = morphomap("map", str(tmp_path / "t0.tif"), str(tmp_path / "t1.tif"), "--smooth", "0.5", "-o", str(out))
     assert done.returncode == 0, done.stderr
     assert "pixel spacing 0.5 x 0.5 (the file)" in done.stderr and "crossings 0" in done.stderr
     field = mm.read_field(out)
     lengths = np.linalg.norm(field.ends - field.starts, axis=1)
     assert np.all(field.valid) and abs(np.median(lengths) - 5.0) < 0.3  # radius 20 -> 25 um
     # --spacing overrides the file (rows,columns); a bad one is refused by argparse.
-    done = subprocess.run([sys.executable, "-m", "morphomap", "map", str(tmp_path / "t0.tif"), str(tmp_path / "t1.tif"),
-                           "--spacing", "1,1", "-o", str(out)], capture_output=True, text=True)
+    done = morphomap("map", str(tmp_path / "t0.tif"), str(tmp_path / "t1.tif"), "--spacing", "1,1", "-o", str(out))
     assert done.returncode == 0 and "pixel spacing 1 x 1 (--spacing)" in done.stderr
-    done = subprocess.run([sys.executable, "-m", "morphomap", "map", str(tmp_path / "t0.tif"), str(tmp_path / "t1.tif"),
-                           "--spacing", "1,2,3"], capture_output=True, text=True)
+    done = morphomap("map", str(tmp_path / "t0.tif"), str(tmp_path / "t1.tif"), "--spacing", "1,2,3")
     assert done.returncode == 2 and "spacing: expected one number or one per axis (rows, columns)" in done.stderr
     # A stack and a mask are not two of a kind.
     np.save(tmp_path / "stack.npy", np.ones((3, 4, 4), np.uint8))
-    done = subprocess.run(
-        [sys.executable, "-m", "morphomap", "map", str(tmp_path / "stack.npy"), str(tmp_path / "t1.tif")],
-        capture_output=True,
-        text=True,
-    )
+    done = morphomap("map", str(tmp_path / "stack.npy"), str(tmp_path / "t1.tif"))
     assert done.returncode == 2 and "is a surface but" in done.stderr and "is a curve" in done.stderr
 
 
@@ -146,12 +139,8 @@ def test_map_reads_stacks_and_mesh_files(tmp_path):
     )
     np.save(tmp_path / "t1.npy", ball(11.0))
     out, plot = tmp_path / "field.csv", tmp_path / "field.png"
-    command = [sys.executable, "-m", "morphomap", "map", str(tmp_path / "t0.tif"), str(tmp_path / "t1.npy")]
-    done = subprocess.run(
-        [*command, "--spacing", "2,0.5,0.5", "--method", "normal", "-o", str(out), "--plot", str(plot)],
-        capture_output=True,
-        text=True,
-    )
+    command = ["map", str(tmp_path / "t0.tif"), str(tmp_path / "t1.npy")]
+    done = morphomap(*command, "--spacing", "2,0.5,0.5", "--method", "normal", "-o", str(out), "--plot", str(plot))
     assert done.returncode == 0, done.stderr
     assert "voxel spacing 2 x 0.5 x 0.5 (--spacing)" in done.stderr and "folds 0" in done.stderr
     field = mm.read_field(out)
@@ -163,28 +152,13 @@ def test_map_reads_stacks_and_mesh_files(tmp_path):
     assert mm.quality(field, s0, s1).folds == 0
     assert plot.stat().st_size > 10_000
     mm.write_surface(tmp_path / "t1.ply", s1)
-    done = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "morphomap",
-            "map",
-            str(tmp_path / "t0.tif"),
-            str(tmp_path / "t1.ply"),
-            "--method",
-            "normal",
-            "-o",
-            str(out),
-        ],
-        capture_output=True,
-        text=True,
-    )
+    done = morphomap("map", str(tmp_path / "t0.tif"), str(tmp_path / "t1.ply"), "--method", "normal", "-o", str(out))
     assert done.returncode == 0, done.stderr
     assert "voxel spacing 2 x 0.5 x 0.5 (the file)" in done.stderr
     # Curve options are refused for surfaces, and uniform is a 2D method.
-    done = subprocess.run([*command, "--spacing", "2,0.5,0.5", "--n", "50"], capture_output=True, text=True)
+    done = morphomap(*command, "--spacing", "2,0.5,0.5", "--n", "50")
     assert done.returncode == 2 and "--n applies to curves, not to surfaces" in done.stderr
-    done = subprocess.run([*command, "--spacing", "2,0.5,0.5", "--method", "uniform"], capture_output=True, text=True)
+    done = morphomap(*command, "--spacing", "2,0.5,0.5", "--method", "uniform")
     assert done.returncode == 2 and "method" in done.stderr
 
 
@@ -197,49 +171,28 @@ def test_extend_writes_the_interior_displacement(tmp_path):
     c1, c2 = mm.load_example("kidney")
     mm.write_curve(tmp_path / "c1.csv", c1)
     mm.write_curve(tmp_path / "c2.csv", c2)
-    command = [sys.executable, "-m", "morphomap", "extend", str(tmp_path / "c1.csv"), str(tmp_path / "c2.csv")]
-    done = subprocess.run(
-        [*command, "--method", "diffusion", "--dt", "2", "-o", str(tmp_path / "u.vtu")], capture_output=True, text=True
-    )
+    command = ["extend", str(tmp_path / "c1.csv"), str(tmp_path / "c2.csv")]
+    done = morphomap(*command, "--method", "diffusion", "--dt", "2", "-o", str(tmp_path / "u.vtu"))
     assert done.returncode == 0, done.stderr
     assert "InteriorField(" in done.stderr and "written to" in done.stderr
     made = meshio.read(tmp_path / "u.vtu")
     assert {"displacement", "velocity"} <= set(made.point_data)
     solver = mm.extend_field(mm.map_curves(c1, c2, "diffusion"), mesh_size=0.1)
     meshio.write(tmp_path / "solver.xdmf", meshio.Mesh(solver.points, [("triangle", solver.cells)]))
-    done = subprocess.run(
-        [*command, "--method", "diffusion", "--mesh", str(tmp_path / "solver.xdmf"), "-o", str(tmp_path / "u.txt")],
-        capture_output=True,
-        text=True,
+    done = morphomap(
+        *command, "--method", "diffusion", "--mesh", str(tmp_path / "solver.xdmf"), "-o", str(tmp_path / "u.txt")
     )
     assert done.returncode == 0, done.stderr
     table = np.loadtxt(tmp_path / "u.txt", comments="%")
     assert np.allclose(table[:, :2], solver.points) and np.allclose(table[:, 2:], solver.displacement)
-    done = subprocess.run(
-        [
-            *command,
-            "--method",
-            "diffusion",
-            "--mesh",
-            str(tmp_path / "solver.xdmf"),
-            "--extension",
-            "elastic",
-            "--substeps",
-            "2",
-            "-o",
-            str(tmp_path / "e.txt"),
-        ],
-        capture_output=True,
-        text=True,
-    )
+    done = morphomap(*command, "--method", "diffusion", "--mesh", str(tmp_path / "solver.xdmf"),
+                     "--extension", "elastic", "--substeps", "2", "-o", str(tmp_path / "e.txt"))
     assert done.returncode == 0, done.stderr
     elastic = mm.extend_field(
         mm.map_curves(c1, c2, "diffusion"), mesh=(solver.points, solver.cells), method="elastic", substeps=2
     )
     assert np.allclose(np.loadtxt(tmp_path / "e.txt", comments="%")[:, 2:], elastic.displacement)
-    done = subprocess.run(
-        [*command, "--mesh", str(tmp_path / "u.txt"), "-o", str(tmp_path / "v.vtu")], capture_output=True, text=True
-    )
+    done = morphomap(*command, "--mesh", str(tmp_path / "u.txt"), "-o", str(tmp_path / "v.vtu"))
     assert done.returncode == 2 and "cannot read the mesh" in done.stderr
 
 
@@ -252,38 +205,14 @@ def test_series_and_batch_commands(tmp_path):
     for k in range(3):
         paths.append(tmp_path / f"t{k}.csv")
         mm.write_curve(paths[-1], circle(120, 1.0 + 0.3 * k))
-    done = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "morphomap",
-            "series",
-            *map(str, paths),
-            "--method",
-            "normal",
-            "--out",
-            str(tmp_path / "series"),
-        ],
-        capture_output=True,
-        text=True,
-    )
+    done = morphomap("series", *map(str, paths), "--method", "normal", "--out", str(tmp_path / "series"))
     assert done.returncode == 0, done.stderr
     assert "step 1:" in done.stderr and "3 frames in 2D" in done.stderr
     table = np.loadtxt(tmp_path / "series" / "trajectories.csv", delimiter=",", skiprows=1)
     assert np.allclose(np.linalg.norm(table[table[:, 0] == 2][:, 2:], axis=1), 1.6)
     (tmp_path / "jobs.csv").write_text("c1,c2\nt0.csv,t1.csv\nt1.csv,t2.csv,diffusion\nt0.csv,missing.csv\n")
-    command = [
-        sys.executable,
-        "-m",
-        "morphomap",
-        "batch",
-        str(tmp_path / "jobs.csv"),
-        "--out",
-        str(tmp_path / "b"),
-        "--workers",
-        "2",
-    ]
-    done = subprocess.run(command, capture_output=True, text=True)
+    command = ["batch", str(tmp_path / "jobs.csv"), "--out", str(tmp_path / "b"), "--workers", "2"]
+    done = morphomap(*command)
     assert done.returncode == 1 and "3 jobs: 2 done or skipped, 1 failed" in done.stderr, done.stderr
     assert mm.read_field(tmp_path / "b" / "002_t1_t2.csv").method[0] == "diffusion"
 
@@ -298,23 +227,8 @@ def test_series_command_writes_growth_maps_figures_and_animation(tmp_path):
     for k, radius in enumerate((1.0, 1.5, 2.5)):
         paths.append(tmp_path / f"t{k}.csv")
         mm.write_curve(paths[-1], circle(60, radius))
-    done = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "morphomap",
-            "series",
-            *map(str, paths),
-            "--method",
-            "normal",
-            "--dt",
-            "0.5",
-            "--no-progress",
-            "--out",
-            str(tmp_path / "s"),
-        ],
-        capture_output=True,
-        text=True,
+    done = morphomap(
+        "series", *map(str, paths), "--method", "normal", "--dt", "0.5", "--no-progress", "--out", str(tmp_path / "s")
     )
     assert done.returncode == 0, done.stderr
     out = tmp_path / "s"
@@ -328,9 +242,5 @@ def test_series_command_writes_growth_maps_figures_and_animation(tmp_path):
         assert Image.open(out / name).format == "PNG"
     with Image.open(out / "series.gif") as gif:
         assert gif.n_frames == 3
-    bad = subprocess.run(
-        [sys.executable, "-m", "morphomap", "series", *map(str, paths), "--reseed", "1", "--out", str(out)],
-        capture_output=True,
-        text=True,
-    )
+    bad = morphomap("series", *map(str, paths), "--reseed", "1", "--out", str(out))
     assert bad.returncode == 2 and "expected a factor > 1 or 'none'" in bad.stderr
