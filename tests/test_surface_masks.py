@@ -120,6 +120,7 @@ def test_labels_cavities_and_several_objects():
         (lambda v: mm.surface_from_mask(v[0]), ValueError, "volume: expected a 3D image"),
         (lambda v: mm.surface_from_mask(v.astype(float)), TypeError, "volume: expected a boolean mask"),
         (lambda v: mm.surface_from_mask(np.zeros_like(v)), ValueError, "volume: has no foreground voxel"),
+        (lambda v: mm.surface_from_mask(v[:0]), ValueError, "volume: has no foreground voxel"),
         (lambda v: mm.surface_from_mask(v, (1, 2)), ValueError, "spacing: expected one number or one per axis"),
         (lambda v: mm.surface_from_mask(v, -1), ValueError, "spacing"),
         (lambda v: mm.surface_from_mask(v, edge_length=0), ValueError, "edge_length"),

@@ -129,7 +129,7 @@ def boundary_from_mask(mask, spacing=1.0, *, label=None, smooth=0.0) -> np.ndarr
 def _bounding_box(mask: np.ndarray) -> tuple[slice, ...] | None:
     """The smallest box holding every set voxel of ``mask``, as one slice per axis; None if none is set.
     Two passes: over the slices, then over the rows and columns of the slices that hold the object."""
-    slices = np.flatnonzero(mask.reshape(len(mask), -1).any(axis=1))
+    slices = np.flatnonzero(mask.reshape(len(mask), -1).any(axis=1)) if mask.size else []
     if len(slices) == 0:
         return None
     z = slice(slices[0], slices[-1] + 1)
