@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Mask -> surface: morphomap.surface_from_mask against the pipeline a user would write.
 
-    PYTHONPATH=build/dev/pkg python3 bench/bench_masks.py [--sizes 256 512x512x128]
+    PYTHONPATH=build/dev/pkg python3 bench/bench_masks.py [--sizes 256 128x512x512] [--runs 3]
 
 A lumpy blob (a ball with smooth random-free bumps) in a stack of 2 x 0.5 x 0.5 um voxels, and the
 same blob grown (the next frame). Each pipeline runs in its own child process, so that its peak
@@ -13,9 +13,11 @@ memory (max RSS) is its own:
   Taubin smoothing (10 rounds) and quadric decimation (fast-simplification) to the face count
   morphomap's surface has.
 
-Reported per stack: seconds, peak memory, faces, minimum triangle angle (the smallest, and the
-1st percentile), and the 3D QM1 of a normal mapping of the frame onto the next (each pipeline's
-own surfaces). Printed as a markdown table; ratios peer / morphomap in one run.
+Reported per stack: seconds (wall and CPU, the CPU time being the steadier on a shared machine),
+peak memory, faces, minimum triangle angle (the smallest, and the 1st percentile), and the 3D QM1
+of a normal mapping of the frame onto the next (each pipeline's own surfaces). Printed as a
+markdown table; ratios peer / morphomap within each run, the two pipelines taking turns
+``--runs`` times: the table shows the first run, the ratio rows the median and the range.
 """
 
 from __future__ import annotations
@@ -79,16 +81,16 @@ def one(pipeline, shape, faces):
     import morphomap as mm
 
     frames = [blob(shape), blob(shape, grown=True)]
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), time.process_time()
     surfaces = [morphomap_surface(f) if pipeline == "morphomap" else peer_surface(f, faces) for f in frames]
-    seconds = (time.perf_counter() - start) / 2
+    seconds, cpu = (time.perf_counter() - start) / 2, (time.process_time() - cpu) / 2
     angles = np.degrees(surfaces[0].face_angles.min(axis=1))
     try:
         field = mm.map_surfaces(surfaces[0], surfaces[1], "normal")
         qm1 = mm.quality(field, surfaces[0], surfaces[1]).qm1
     except ValueError as error:  # the peer's surface may not be closed after decimation
         qm1 = f"refused: {str(error).split(':')[1].strip()[:40]}"
-    print(json.dumps({"seconds": seconds, "faces": len(surfaces[0].faces), "min_angle": float(angles.min()),
+    print(json.dumps({"seconds": seconds, "cpu": cpu, "faces": len(surfaces[0].faces), "min_angle": float(angles.min()),
                       "p1_angle": float(np.percentile(angles, 1)), "qm1": qm1,
                       "watertight": bool(surfaces[0].is_watertight),
                       "max_rss_gb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20}))
@@ -108,6 +110,7 @@ def parse_shape(text):
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--sizes", nargs="+", default=["256", "128x512x512"])
+    parser.add_argument("--runs", type=int, default=1, help="times each pipeline runs, taking turns")
     parser.add_argument("--one", nargs=3, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.one:
@@ -115,24 +118,32 @@ def main():
         one(pipeline, parse_shape(shape), int(faces))
         return
     print(
-        "| stack (z x y x x) | pipeline | s per frame | peak GB | faces | min angle | 1% angle | watertight "
-        "| QM1 normal |"
+        "| stack (z x y x x) | pipeline | s per frame | CPU s per frame | peak GB | faces | min angle | 1% angle "
+        "| watertight | QM1 normal |"
     )
-    print("|---|---|---:|---:|---:|---:|---:|---|---:|")
+    print("|---|---|---:|---:|---:|---:|---:|---:|---|---:|")
     for text in args.sizes:
         shape = parse_shape(text)
-        ours = child("morphomap", shape)
-        peer = child("peer", shape, ours["faces"])
+        runs = []
+        for _ in range(args.runs):
+            ours = child("morphomap", shape)
+            runs.append((ours, child("peer", shape, ours["faces"])))
+        ours, peer = runs[0]
         for name, r in (("morphomap", ours), ("skimage + trimesh", peer)):
             qm1 = f"{r['qm1']:.4g}" if isinstance(r["qm1"], float) else r["qm1"]
             print(
-                f"| {'x'.join(map(str, shape))} | {name} | {r['seconds']:.2f} | {r['max_rss_gb']:.2f} | {r['faces']} | "
-                f"{r['min_angle']:.1f} | {r['p1_angle']:.1f} | {r['watertight']} | {qm1} |"
+                f"| {'x'.join(map(str, shape))} | {name} | {r['seconds']:.2f} | {r['cpu']:.2f} | {r['max_rss_gb']:.2f} "
+                f"| {r['faces']} | {r['min_angle']:.1f} | {r['p1_angle']:.1f} | {r['watertight']} | {qm1} |"
             )
+
+        def ratio(key):
+            values = sorted(p[key] / o[key] for o, p in runs)
+            spread = f" ({values[0]:.2f}–{values[-1]:.2f})" if len(values) > 1 else ""
+            return f"{np.median(values):.2f}{spread}"
+
         print(
-            f"| | peer / morphomap | {peer['seconds'] / ours['seconds']:.2f} "
-            f"| {peer['max_rss_gb'] / ours['max_rss_gb']:.2f} | | "
-            f"{peer['min_angle'] / max(ours['min_angle'], 1e-9):.3f} | | | |"
+            f"| | peer / morphomap, {len(runs)} runs | {ratio('seconds')} | {ratio('cpu')} | {ratio('max_rss_gb')} | | "
+            f"morphomap / peer {ours['min_angle'] / max(peer['min_angle'], 1e-9):.0f}× | | | |"
         )
 
 

@@ -85,6 +85,18 @@ def test_coordinates_follow_the_axes():
     assert surface.volume > 0
 
 
+def test_the_surface_moves_with_the_object_in_its_stack():
+    # Only the object's bounding box is contoured: the same ball shifted by (3, 7, 11) voxels in
+    # a larger stack gives the same surface shifted by (11 sx, 7 sy, 3 sz), whatever the blocks.
+    volume = ball((14, 60, 60), np.array([15.2, 14.9, 13.0]), 12.0, SPACING)
+    larger = np.zeros((19, 72, 72), bool)
+    larger[3:17, 7:67, 11:71] = volume
+    here, there = (mm.surface_from_mask(v, SPACING) for v in (volume, larger))
+    shift = np.array([11 * SPACING[2], 7 * SPACING[1], 3 * SPACING[0]])
+    assert len(here.vertices) == len(there.vertices)
+    assert np.sort(here.vertices + shift, axis=0) == pytest.approx(np.sort(there.vertices, axis=0), abs=1e-4)
+
+
 def test_labels_cavities_and_several_objects():
     volume = np.zeros((20, 40, 40), np.uint16)
     volume[ball((20, 40, 40), (10, 10, 10), 6, (1, 1, 1))] = 3
@@ -108,6 +120,7 @@ def test_labels_cavities_and_several_objects():
         (lambda v: mm.surface_from_mask(v[0]), ValueError, "volume: expected a 3D image"),
         (lambda v: mm.surface_from_mask(v.astype(float)), TypeError, "volume: expected a boolean mask"),
         (lambda v: mm.surface_from_mask(np.zeros_like(v)), ValueError, "volume: has no foreground voxel"),
+        (lambda v: mm.surface_from_mask(v[:0]), ValueError, "volume: has no foreground voxel"),
         (lambda v: mm.surface_from_mask(v, (1, 2)), ValueError, "spacing: expected one number or one per axis"),
         (lambda v: mm.surface_from_mask(v, -1), ValueError, "spacing"),
         (lambda v: mm.surface_from_mask(v, edge_length=0), ValueError, "edge_length"),
