@@ -17,6 +17,9 @@ struct MonotoneMatch {
   Points2 points;       // the end points on the target
   double energy = 0.0;  // the minimised energy (below)
   Index samples = 0;    // M: the target was sampled at M + 1 equally spaced positions
+  // Every vector lies inside the region between the pieces, so none crosses another (below);
+  // false: the penalised matching, checked to have no crossings.
+  bool by_construction = false;
 };
 
 // Matches the start points source.row(start_rows[i]) (rows increasing) of the open polyline
