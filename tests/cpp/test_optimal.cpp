@@ -11,6 +11,7 @@
 #include <cmath>
 #include <vector>
 
+using morphomap::GeometryError;
 using morphomap::Index;
 using morphomap::InvalidInput;
 using morphomap::monotone_match;
@@ -85,6 +86,7 @@ void parallel_lines(Index n, double width, double w) {
   // stay near the minimiser rather than on it.
   const double off = (match.arcs - best).cwiseAbs().maxCoeff();
   CHECK(off <= (n <= 256 ? 4 * sample : 0.025 * width));
+  CHECK(match.by_construction);  // the pieces and their end vectors bound a quadrilateral
   for (Index i = 0; i < n; ++i) {
     CHECK_NEAR(match.points(i, 0), match.arcs[i], 1e-12);
     CHECK_NEAR(match.points(i, 1), 1.0, 1e-12);
@@ -112,6 +114,14 @@ void pinned_ends() {
   CHECK_NEAR(match.points(11, 0), 2.0, 0.0);
 }
 
+// The target run the other way: the vectors joining the pieces' ends cross, so there is no region
+// and an order-preserving matching crosses itself: refused rather than returned.
+void reversed_target_refused() {
+  Lines l = lines(20, 1.0);
+  l.target = Points2(l.target.colwise().reverse());
+  CHECK_THROWS(monotone_match(l.source, l.rows, l.target, 1.0), GeometryError);
+}
+
 void bad_input() {
   const Lines l = lines(5, 1.0);
   CHECK_THROWS(monotone_match(l.source, {3, 2}, l.target, 1.0), InvalidInput);
@@ -128,6 +138,7 @@ int main() {
   parallel_lines(3000, 2.0, 1.0);
   parallel_lines(3000, 1.5, 0.3);
   pinned_ends();
+  reversed_target_refused();
   bad_input();
   TEST_MAIN_END();
 }
