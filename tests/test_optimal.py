@@ -60,8 +60,8 @@ def test_shared_frames():
 
 
 # 16, 24, 31, 35: staircase contours whose vectors crossed one, two or three apart. 10: the first
-# pass's anchor runs along a staircase edge of C2 (no region to constrain to; the second pass
-# alone). 52: a piece with no path inside its region at the sampling (the penalised path, checked).
+# pass's anchor runs along a staircase edge of C2 (its region is not a simple polygon: that pass is
+# counted). 52: a piece with no path inside its region at the sampling (the penalised path, counted).
 @pytest.mark.parametrize("seed", [0, 1, 2, 4, 5, 6, 10, 16, 24, 31, 35, 52])
 def test_fuzz_pairs(seed):
     pair = frames.curve_pair(seed, "careful")

@@ -229,19 +229,9 @@ Points2 optimal_ends(const Job& job, double stretch_weight) {
   MonotoneMatch first, second;
   const double anchor = refined_anchor(source, target, best_anchor(source, target, 1)) +
                         source.arc(job.start_rows[0]) * target.length() / source.length();
-  const Index half = count / 2;
-  Points2 ends;
-  try {
-    ends = pass(0, anchor, first);
-  } catch (const GeometryError&) {
-    // No crossing-free matching from this anchor (it can run along a curve on pixel contours):
-    // the second pass alone, cut where the shift puts the start point half way round.
-    if (count < 2) throw;
-    const double shift =
-        (source.arc(job.start_rows[half]) - source.arc(job.start_rows[0])) * target.length() / source.length();
-    return pass(half, anchor + shift, second);
-  }
+  Points2 ends = pass(0, anchor, first);
   if (count < 2) return ends;
+  const Index half = count / 2;
   Points2 other = pass(half, anchor + first.arcs[half], second);
   return second.energy < first.energy ? other : ends;
 }

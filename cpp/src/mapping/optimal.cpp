@@ -370,54 +370,66 @@ MonotoneMatch monotone_match(const Points2Ref& source, const std::vector<Index>&
     levels.push_back(std::move(rows));
   }
 
-  // With the region: crossing-free by construction where it is a simple polygon (or the cut ring);
-  // where it is not, its vectors are still the likeliest to be free of crossings. Without a path
-  // inside it, the penalised one. Either of the last two is kept only if it has no crossings.
+  // The pieces' end vectors not among the starts' own, for the crossing count (once where they
+  // are one, as on a cut ring).
+  std::vector<Vec2> from, to;
+  if (!p.pinned_first) from.push_back(p.begin_source), to.push_back(p.begin_target);
+  const bool one_vector = p.end_source == p.begin_source && p.end_target == p.begin_target;
+  if (!p.pinned_last && !one_vector) from.push_back(p.end_source), to.push_back(p.end_target);
+  Points2 starts(n + static_cast<Index>(from.size()), 2);
+  starts.topRows(n) = p.starts;
+  for (std::size_t e = 0; e < from.size(); ++e) starts.row(n + static_cast<Index>(e)) = from[e].transpose();
+  // The path's ends and an exact count of its crossings.
   std::vector<double> coarse_t;
   double energy = 0.0;
-  std::unique_ptr<MatchRegion> region;
+  auto take = [&] {
+    for (Index r = 0; r < n; ++r) {
+      match.arcs[r] = coarse_t[r];
+      match.points.row(r) = curve.point_at(coarse_t[r]).transpose();
+    }
+    if (p.pinned_first) match.points.row(0) = p.begin_target.transpose();
+    if (p.pinned_last) match.points.row(n - 1) = p.end_target.transpose();
+    match.energy = energy;
+    Points2 ends(starts.rows(), 2);
+    ends.topRows(n) = match.points;
+    for (std::size_t e = 0; e < to.size(); ++e) ends.row(n + static_cast<Index>(e)) = to[e].transpose();
+    return count_crossings(starts, ends);
+  };
+
+  // With the region: crossing-free by construction where it is a simple polygon (or the cut ring);
+  // where it is not, its vectors are still the likeliest to be free of crossings. Without a path
+  // inside it, the penalised one. Every result is counted exactly (the line queries round at 1e-9
+  // of a vector's length) and returned only without crossings.
   const bool free_rows = n > static_cast<Index>(p.pinned_first) + static_cast<Index>(p.pinned_last);
+  std::unique_ptr<MatchRegion> region;
   std::string why_not;
-  bool inside = !free_rows;
+  Index crossings = 0;
+  bool inside = false;
   if (free_rows) {
     region = std::make_unique<MatchRegion>(source, target);
     why_not = region->why_not();
     p.region = region.get();
     inside = solve_levels(p, levels, finest, start_rows, coarse_t, energy);
+    if (inside) crossings = take();
+  } else {
+    solve_levels(p, levels, finest, start_rows, coarse_t, energy);
+    crossings = take();
   }
-  match.by_construction = inside && why_not.empty();
-  if (!inside) {
-    if (why_not.empty())
-      why_not = "no path of vectors inside the region between them was found at the matching's sampling";
+  match.by_construction = inside && why_not.empty() && crossings == 0;
+  if (free_rows && (!inside || crossings > 0)) {
+    if (why_not.empty()) {
+      why_not = inside ? "the vectors inside the region cross by rounding"
+                       : "no path of vectors inside the region between them was found at the matching's sampling";
+    }
     p.region = nullptr;
     solve_levels(p, levels, finest, start_rows, coarse_t, energy);
+    crossings = take();
   }
-  for (Index r = 0; r < n; ++r) {
-    match.arcs[r] = coarse_t[r];
-    match.points.row(r) = curve.point_at(coarse_t[r]).transpose();
-  }
-  if (p.pinned_first) match.points.row(0) = p.begin_target.transpose();
-  if (p.pinned_last) match.points.row(n - 1) = p.end_target.transpose();
-  match.energy = energy;
-  if (!match.by_construction) {
-    // The penalised path, checked exactly with the pieces' end vectors (once where they are one).
-    Points2 starts = p.starts, ends = match.points;
-    std::vector<Vec2> from, to;
-    if (!p.pinned_first) from.push_back(p.begin_source), to.push_back(p.begin_target);
-    const bool same = p.end_source == p.begin_source && p.end_target == p.begin_target;
-    if (!p.pinned_last && !(same && !from.empty())) from.push_back(p.end_source), to.push_back(p.end_target);
-    starts.conservativeResize(n + static_cast<Index>(from.size()), 2);
-    ends.conservativeResize(n + static_cast<Index>(from.size()), 2);
-    for (std::size_t e = 0; e < from.size(); ++e) {
-      const Index row = n + static_cast<Index>(e);
-      starts.row(row) = from[e].transpose(), ends.row(row) = to[e].transpose();
-    }
-    const Index crossings = count_crossings(starts, ends);
-    if (crossings > 0) {
-      throw GeometryError("optimal: no crossing-free order-preserving matching of a pair of pieces (" + why_not +
-                          "; the matching without that constraint has " + std::to_string(crossings) +
-                          " crossing pairs); method 'best' keeps the best crossing-free candidate");
-    }
+  if (crossings > 0) {
+    throw GeometryError("optimal: no crossing-free order-preserving matching of a pair of pieces (" +
+                        (why_not.empty() ? std::string("its ends are fixed") : why_not) +
+                        "; the matching without that constraint has " + std::to_string(crossings) +
+                        " crossing pairs); method 'best' keeps the best crossing-free candidate");
   }
   return match;
 }
