@@ -114,6 +114,28 @@ void pinned_ends() {
   CHECK_NEAR(match.points(11, 0), 2.0, 0.0);
 }
 
+// Whole closed curves cut open (as method "optimal" passes them): concentric circles, cut at angle
+// 0 on both. The region is the ring cut along the pinned first vector, nested and simple, so the
+// matching is crossing-free by construction, and radial to within two target samples.
+void cut_concentric_circles() {
+  const Index n = 100, m = 300;
+  auto circle = [](Index count, double radius) {
+    Points2 c(count + 1, 2);
+    for (Index i = 0; i <= count; ++i) {
+      const double t = 2.0 * M_PI * static_cast<double>(i % count) / static_cast<double>(count);
+      c.row(i) << radius * std::cos(t), radius * std::sin(t);
+    }
+    return c;
+  };
+  const Points2 source = circle(n, 1.0), target = circle(m, 2.0);
+  std::vector<Index> rows(n);
+  for (Index i = 0; i < n; ++i) rows[i] = i;
+  const auto match = monotone_match(source, rows, target);
+  CHECK(match.by_construction);
+  const double sample = 2.0 * M_PI * 2.0 / static_cast<double>(match.samples);
+  for (Index i = 0; i < n; ++i) CHECK_NEAR(match.arcs[i], 2.0 * 2.0 * M_PI * i / n, 2.0 * sample);
+}
+
 // The target run the other way: the vectors joining the pieces' ends cross, so there is no region
 // and an order-preserving matching crosses itself: refused rather than returned.
 void reversed_target_refused() {
@@ -138,6 +160,7 @@ int main() {
   parallel_lines(3000, 2.0, 1.0);
   parallel_lines(3000, 1.5, 0.3);
   pinned_ends();
+  cut_concentric_circles();
   reversed_target_refused();
   bad_input();
   TEST_MAIN_END();
