@@ -13,6 +13,9 @@
 #include <tbb/parallel_for.h>
 
 #include <cmath>
+#include <string>
+#include <tuple>
+#include <vector>
 
 namespace morphomap::detail {
 
