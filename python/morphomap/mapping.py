@@ -64,11 +64,17 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
         paper's QM1 term over consecutive vectors). The ends are chosen among 4 to 8 equally
         spaced positions on C2 per start point (the matching's resolution); coarse to fine, so
         that 10^4 points per curve take well under a second. Guaranteed: the order (the ends run
-        along C2 in the order of the start points, every part of it reached); crossings are
-        avoided where the matching can (each vector against the three before it), and none can
-        occur where every vector lies in the region between its two pieces; they are not
-        excluded in general (none measured: bench/README.md). See ``monotone_match`` in the C++
-        header ``morphomap/optimal.hpp``.
+        along C2 in the order of the start points, every part of it reached) and no crossings
+        within a pair of segments. Each vector must lie inside the region between its two
+        segments (bounded by them and the vectors joining their ends; whole closed curves: the
+        ring between them cut along the first vector); where that region is a simple polygon no
+        two such vectors can cross, by construction. Where it is not (the segments or the joining
+        vectors meet elsewhere), or no such path exists at the matching's resolution (a deep
+        narrow bud that few start points face), the field is kept only if an exact count finds no
+        crossing; otherwise ``GeometryError`` ("no crossing-free order-preserving matching"):
+        ``"optimal"`` never returns crossings within a pair of segments (pairs whose regions
+        overlap are not checked against each other). See ``monotone_match`` in the C++ header
+        ``morphomap/optimal.hpp``.
         ``"best"`` (beyond the paper): runs every candidate — normal, minimal distance, diffusion,
         each plain, reversed, transformed and both, ``"optimal"`` and ``"auto"`` — and keeps, on
         each piece between the split points (as above), the one without crossings or misses of

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <vector>
 
+using morphomap::GeometryError;
 using morphomap::Index;
 using morphomap::InvalidInput;
 using morphomap::monotone_match;
@@ -85,6 +86,7 @@ void parallel_lines(Index n, double width, double w) {
   // stay near the minimiser rather than on it.
   const double off = (match.arcs - best).cwiseAbs().maxCoeff();
   CHECK(off <= (n <= 256 ? 4 * sample : 0.025 * width));
+  CHECK(match.by_construction);  // the pieces and their end vectors bound a quadrilateral
   for (Index i = 0; i < n; ++i) {
     CHECK_NEAR(match.points(i, 0), match.arcs[i], 1e-12);
     CHECK_NEAR(match.points(i, 1), 1.0, 1e-12);
@@ -112,6 +114,36 @@ void pinned_ends() {
   CHECK_NEAR(match.points(11, 0), 2.0, 0.0);
 }
 
+// Whole closed curves cut open (as method "optimal" passes them): concentric circles, cut at angle
+// 0 on both. The region is the ring cut along the pinned first vector, nested and simple, so the
+// matching is crossing-free by construction, and radial to within two target samples.
+void cut_concentric_circles() {
+  const Index n = 100, m = 300;
+  auto circle = [](Index count, double radius) {
+    Points2 c(count + 1, 2);
+    for (Index i = 0; i <= count; ++i) {
+      const double t = 2.0 * M_PI * static_cast<double>(i % count) / static_cast<double>(count);
+      c.row(i) << radius * std::cos(t), radius * std::sin(t);
+    }
+    return c;
+  };
+  const Points2 source = circle(n, 1.0), target = circle(m, 2.0);
+  std::vector<Index> rows(n);
+  for (Index i = 0; i < n; ++i) rows[i] = i;
+  const auto match = monotone_match(source, rows, target);
+  CHECK(match.by_construction);
+  const double sample = 2.0 * M_PI * 2.0 / static_cast<double>(match.samples);
+  for (Index i = 0; i < n; ++i) CHECK_NEAR(match.arcs[i], 2.0 * 2.0 * M_PI * i / n, 2.0 * sample);
+}
+
+// The target run the other way: the vectors joining the pieces' ends cross, so there is no region
+// and an order-preserving matching crosses itself: refused rather than returned.
+void reversed_target_refused() {
+  Lines l = lines(20, 1.0);
+  l.target = Points2(l.target.colwise().reverse());
+  CHECK_THROWS(monotone_match(l.source, l.rows, l.target, 1.0), GeometryError);
+}
+
 void bad_input() {
   const Lines l = lines(5, 1.0);
   CHECK_THROWS(monotone_match(l.source, {3, 2}, l.target, 1.0), InvalidInput);
@@ -128,6 +160,8 @@ int main() {
   parallel_lines(3000, 2.0, 1.0);
   parallel_lines(3000, 1.5, 0.3);
   pinned_ends();
+  cut_concentric_circles();
+  reversed_target_refused();
   bad_input();
   TEST_MAIN_END();
 }

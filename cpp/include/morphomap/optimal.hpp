@@ -17,6 +17,9 @@ struct MonotoneMatch {
   Points2 points;       // the end points on the target
   double energy = 0.0;  // the minimised energy (below)
   Index samples = 0;    // M: the target was sampled at M + 1 equally spaced positions
+  // Every vector lies inside the region between the pieces, a simple polygon, so none can cross
+  // another (below); false: a matching found otherwise, counted to have no crossings.
+  bool by_construction = false;
 };
 
 // Matches the start points source.row(start_rows[i]) (rows increasing) of the open polyline
@@ -32,32 +35,46 @@ struct MonotoneMatch {
 // l_j, L_j the arc lengths between consecutive starts / ends, alpha = target length / source
 // length (so that the uniform map has no stretch), g^2 the mean squared distance from the starts
 // to the target (at least the squared mean spacing of the starts, so that touching pieces stay
-// well posed), w = stretch_weight (the paper's QM1 term; 0: nearest monotone matching). A step
-// whose new vector crosses or touches (other than at a shared end) one of the three vectors before
-// it costs 1e6 more, so the path avoids crossings where it can: exactly for the neighbour, for the
-// two before that as the best path into the previous state has them (the state holds one vector;
-// staircase contours of masks cross two or three apart). Vectors further apart are not checked. Each step advances by 1
-// .. 8 M / (n + 1) + 2 samples.
+// well posed), w = stretch_weight (the paper's QM1 term; 0: nearest monotone matching).
+// Each step advances by 1 .. 8 M / (n + 1) + 2 samples.
 //
-// What is guaranteed, and what is not:
-// - By construction: the order. Ends strictly increase along the target (bijective at the
-//   sampling), the pieces' ends are pinned, so every stretch of the target lies between two ends.
-// - Crossings: a step that crosses one of the three vectors checked is taken only where every
-//   path avoiding it costs 1e6 more (the penalty is added, not forbidden). Vectors four or more
-//   apart are not checked. A sufficient condition that rules every crossing out: each vector lies
-//   inside the region bounded by the two pieces (they meet only at their ends, so it is a simple
-//   polygon; whole closed curves: the ring between them cut along the first vector), since two chords of a simple
-//   polygon whose ends do not interleave along its boundary cannot cross, and an order-preserving matching's ends never
-//   interleave (start i, start j, end j, end i follow each other round the boundary). Vectors that leave the region
-//   (round a bend of either curve) are not covered by it, so no crossing-free result is
-//   promised: measured 0 on the bundled pairs, the shared frames and 60 fuzz pairs
-//   (bench/README.md).
+// The region, a hard constraint: the pieces and the two end vectors bound a region (whole closed
+// curves: the ring between them cut along the first vector). A vector p_i -> q_k may be taken only
+// if it lies inside that region: no point of the region's boundary strictly between its ends (one
+// line query from its midpoint, up to 1e-9 of its length), and it leaves both curves into the
+// region (exact orientation tests at both ends, so that a vector along a curve or out of the region
+// is refused). A vector of length 0 (the curves touching there) is taken.
+//
+// What is guaranteed, and when:
+// - Always: the order. Ends strictly increase along the target (bijective at the sampling), the
+//   pieces' ends are pinned, so every stretch of the target lies between two ends.
+// - No two vectors of the result cross (crossing_pairs: no common point but a shared end), nor
+//   cross the end vectors:
+//   * by construction (by_construction) where the region is the inside of a simple polygon (the
+//     pieces meet only at their ends, the end vectors cross nothing; checked exactly) or, whole
+//     closed curves, the ring between two disjoint nested simple curves cut along a first vector
+//     that meets them only at its ends, and a path of vectors inside it exists at the sampling
+//     (the band widened at most twice). Two straight segments inside a simple polygon whose ends
+//     lie on its boundary without interleaving cannot cross (one would separate the other's ends),
+//     and a monotone matching's ends never interleave: start i, start j, end j, end i follow each
+//     other round the boundary;
+//   * otherwise, as checked: the path of vectors inside the region (where it is not simple), else
+//     the penalised path (a step whose vector crosses or touches one of the three before it on the
+//     path costs 1e6 more), is returned only if an exact count (count_crossings, the end vectors
+//     included) finds no crossing; else GeometryError ("no crossing-free order-preserving
+//     matching"), never a field with crossings. (Every result is counted so, the ones by
+//     construction too: their inside test rounds at 1e-9 of a vector's length.)
+// - Between pieces (method "optimal" maps each pair of pieces between split points on its own):
+//   vectors of two pieces cannot cross where the pieces' regions do not overlap, as for curves
+//   that cross in the same order along both.
 //
 // Cost: coarse to fine. The starts are thinned by 4 per level down to <= 256, where the DP runs on
 // the full grid; each finer level searches only a band of +- max(16, 8 M / (n + 1)) samples around
 // the coarser path carried over by arc length (widened if the band admits no path). About
-// n * band * step transitions per level: linear in n.
-// InvalidInput naming "source", "start_rows", "target" or "stretch_weight" for bad input.
+// n * band * step transitions per level and one line query per cell of the band: linear in n
+// (bench/README.md: 10^4 points per curve in under a second on 2 cores).
+// InvalidInput naming "source", "start_rows", "target" or "stretch_weight" for bad input;
+// GeometryError where no crossing-free matching was found (above).
 MonotoneMatch monotone_match(const Points2Ref& source, const std::vector<Index>& start_rows, const Points2Ref& target,
                              double stretch_weight = kDefaultStretchWeight);
 

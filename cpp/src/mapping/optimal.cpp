@@ -1,5 +1,6 @@
 // The monotone matching behind method "optimal": dynamic programming over start points x target
 // samples, coarse to fine with a band around the coarser path.
+#include <morphomap/crossings.hpp>
 #include <morphomap/curve_queries.hpp>
 #include <morphomap/optimal.hpp>
 
@@ -7,6 +8,7 @@
 #include "common/numbers.hpp"
 #include "common/validation.hpp"
 #include "curves/arc_curve.hpp"
+#include "mapping/match_region.hpp"
 
 #include <morphomap/errors.hpp>
 
@@ -14,6 +16,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -24,10 +27,12 @@ using detail::kInf;
 namespace {
 
 using detail::ArcCurve;
-constexpr double kCrossing = 1e6;  // added where two consecutive vectors cross
+using detail::MatchRegion;
+constexpr double kCrossing = 1e6;  // without the region: added where two close vectors cross
 constexpr Index kThinning = 4;     // starts per level
 constexpr Index kCoarsest = 256;   // the full grid is searched at or below this many starts
 constexpr Index kRecent = 3;       // vectors back along the path checked for crossings
+constexpr Index kWidenings = 2;    // with the region: doublings of a level's band before giving up
 
 // The problem of one call: start points with their arc positions, the two pieces' lengths, the
 // virtual vectors at both ends, and the weights.
@@ -41,6 +46,7 @@ struct Problem {
   double stretch_weight = kDefaultStretchWeight;
   double alpha = 1.0;
   const ArcCurve* target = nullptr;
+  const MatchRegion* region = nullptr;  // the hard constraint, where the region is a polygon
 };
 
 double orient(const Vec2& a, const Vec2& b, const Vec2& c) {
@@ -67,12 +73,50 @@ bool cross(const Vec2& a0, const Vec2& a1, const Vec2& b0, const Vec2& b1) {
 }
 
 // One level: the starts `rows` (indices into Problem::starts, increasing), the target sampled at
-// M + 1 positions, and for each row the range of samples it may take.
+// M + 1 positions, and for each row the range of samples it may take; with the region, which of
+// those vectors lie inside it (row r, sample k at admitted[first[r] + k - lo[r]]).
 struct Level {
   std::vector<Index> rows;
   Index samples = 0;  // M
   std::vector<Index> lo, hi;
+  std::vector<char> admitted;
+  std::vector<Index> first;
 };
+
+// The M + 1 target samples, the ends exactly the pieces' ends.
+std::vector<Vec2> target_samples(const Problem& p, Index samples) {
+  const double step_length = p.target_length / static_cast<double>(samples);
+  std::vector<Vec2> q(samples + 1);
+  for (Index k = 0; k <= samples; ++k) q[k] = p.target->point_at(step_length * k);
+  q[0] = p.begin_target, q[samples] = p.end_target;
+  return q;
+}
+
+// Fills level.admitted from the region: one query per cell of the band. A pinned row's vector is
+// a side of the region itself and always admitted.
+void admit(const Problem& p, const std::vector<Index>& source_rows, Level& level) {
+  const Index count = static_cast<Index>(level.rows.size());
+  const std::vector<Vec2> q = target_samples(p, level.samples);
+  const double step_length = p.target_length / static_cast<double>(level.samples);
+  level.first.assign(count, 0);
+  Index cells = 0;
+  for (Index r = 0; r < count; ++r) level.first[r] = cells, cells += std::max<Index>(0, level.hi[r] - level.lo[r] + 1);
+  std::vector<Index> rows(cells), segments(cells);
+  Points2 ends(cells, 2);
+  for (Index r = 0; r < count; ++r) {
+    for (Index k = level.lo[r]; k <= level.hi[r]; ++k) {
+      const Index c = level.first[r] + k - level.lo[r];
+      rows[c] = source_rows[level.rows[r]];
+      ends.row(c) = q[k].transpose();
+      segments[c] = p.target->segment_at(step_length * k);
+    }
+  }
+  level.admitted = p.region->admits(rows, ends, segments);
+  for (Index r = 0; r < count; ++r) {
+    const bool pinned = (r == 0 && p.pinned_first) || (r == count - 1 && p.pinned_last);
+    if (pinned && level.hi[r] >= level.lo[r]) level.admitted[level.first[r]] = 1;
+  }
+}
 
 // Feasible sample range of row r of R so that a strictly increasing path exists.
 std::pair<Index, Index> feasible(const Problem& p, Index r, Index count, Index samples) {
@@ -92,9 +136,10 @@ bool solve_level(const Problem& p, const Level& level, std::vector<Index>& path,
   const Index samples = level.samples;
   const double step_length = p.target_length / static_cast<double>(samples);
   const Index reach = max_step(samples, count);
-  std::vector<Vec2> q(samples + 1);
-  for (Index k = 0; k <= samples; ++k) q[k] = p.target->point_at(step_length * k);
-  q[0] = p.begin_target, q[samples] = p.end_target;
+  const std::vector<Vec2> q = target_samples(p, samples);
+  // With the region every vector taken lies inside it, so none can cross another (optimal.hpp):
+  // the crossing penalty is not needed.
+  const bool constrained = !level.admitted.empty();
 
   auto stretch = [&](double target_gap, double source_gap) {
     if (!(source_gap > 0.0)) return 0.0;
@@ -139,6 +184,7 @@ bool solve_level(const Problem& p, const Level& level, std::vector<Index>& path,
                        static_cast<Index>(std::ceil(8.0 * static_cast<double>(samples) * dl / p.source_length)) + 2)
             : reach;
     for (Index k = lo; k <= hi; ++k) {
+      if (constrained && !level.admitted[level.first[r] + k - lo]) continue;
       const double displacement = p.displacement_weight * (pi - q[k]).squaredNorm();
       double best = kInf;
       Index arg = -1;
@@ -149,7 +195,7 @@ bool solve_level(const Problem& p, const Level& level, std::vector<Index>& path,
         if (before == kInf) continue;
         double c = before + stretch(step_length * (k - kp), dl);
         if (!(c < best)) continue;  // the crossing tests only where the step could win
-        if (!first && crosses_recent(level, back, r, kp, pi, q[k])) c += kCrossing;
+        if (!first && !constrained && crosses_recent(level, back, r, kp, pi, q[k])) c += kCrossing;
         if (c < best) best = c, arg = kp;
       }
       if (arg >= 0) cost[r][k - lo] = best + displacement, back[r][k - lo] = static_cast<std::int32_t>(arg);
@@ -165,7 +211,7 @@ bool solve_level(const Problem& p, const Level& level, std::vector<Index>& path,
     if (c == kInf) continue;
     if (!(p.pinned_last)) {
       c += stretch(p.target_length - step_length * k, dl);
-      if (cross(p.starts.row(last).transpose(), q[k], p.end_source, p.end_target)) c += kCrossing;
+      if (!constrained && cross(p.starts.row(last).transpose(), q[k], p.end_source, p.end_target)) c += kCrossing;
     }
     if (c < best) best = c, arg = k;
   }
@@ -196,6 +242,65 @@ std::vector<double> carry(const Problem& p, const std::vector<Index>& coarse_row
     out[r] = t[j] + f * (t[j + 1] - t[j]);
   }
   return out;
+}
+
+// All levels, coarse to fine, into the target positions of the starts (coarse_t) and the energy.
+// With p.region the finest level takes only vectors inside the region, its band widened at most
+// kWidenings times (false when that finds no path); a coarser level that finds none there is
+// solved without it (it only centres the next band). Without the region a band is widened until
+// a path exists.
+bool solve_levels(const Problem& p, const std::vector<std::vector<Index>>& levels, Index finest,
+                  const std::vector<Index>& start_rows, std::vector<double>& coarse_t, double& energy) {
+  const Index n = static_cast<Index>(levels.front().size());
+  std::vector<Index> coarse_rows;
+  for (auto level_rows = levels.rbegin(); level_rows != levels.rend(); ++level_rows) {
+    Level level;
+    level.rows = *level_rows;
+    const bool finest_level = level_rows + 1 == levels.rend();
+    const Index count = static_cast<Index>(level.rows.size());
+    level.samples = std::max(4 * (count + 1), (finest * (count + 1) + n) / (n + 1));
+    const double per_sample = p.target_length / static_cast<double>(level.samples);
+    const std::vector<double> centre =
+        coarse_rows.empty() ? std::vector<double>() : carry(p, coarse_rows, coarse_t, level.rows);
+    const Index first_band = std::max<Index>(16, 8 * level.samples / (count + 1));
+    Index band = first_band;
+    bool constrained = p.region != nullptr;
+    std::vector<Index> path;
+    for (;;) {
+      level.lo.resize(count), level.hi.resize(count);
+      for (Index r = 0; r < count; ++r) {
+        auto [lo, hi] = feasible(p, r, count, level.samples);
+        if (!centre.empty() && band < level.samples) {
+          const Index c = static_cast<Index>(std::llround(centre[r] / per_sample));
+          lo = std::max(lo, c - band), hi = std::min(hi, c + band);
+        }
+        level.lo[r] = lo, level.hi[r] = hi;
+      }
+      if (constrained) {
+        admit(p, start_rows, level);
+      } else {
+        level.admitted.clear();
+      }
+      if (solve_level(p, level, path, energy)) break;
+      if (constrained && !centre.empty() && band < (first_band << kWidenings) && band < level.samples) {
+        band *= 2;
+        continue;
+      }
+      if (constrained) {
+        if (finest_level) return false;
+        constrained = false, band = first_band;
+        continue;
+      }
+      if (centre.empty() || band >= level.samples) {
+        throw GeometryError("optimal: no monotone matching (more start points than the target can separate)");
+      }
+      band *= 2;
+    }
+    coarse_rows = level.rows;
+    coarse_t.resize(count);
+    for (Index r = 0; r < count; ++r) coarse_t[r] = per_sample * path[r];
+  }
+  return true;
 }
 
 }  // namespace
@@ -265,46 +370,67 @@ MonotoneMatch monotone_match(const Points2Ref& source, const std::vector<Index>&
     levels.push_back(std::move(rows));
   }
 
-  std::vector<Index> coarse_rows;
+  // The pieces' end vectors not among the starts' own, for the crossing count (once where they
+  // are one, as on a cut ring).
+  std::vector<Vec2> from, to;
+  if (!p.pinned_first) from.push_back(p.begin_source), to.push_back(p.begin_target);
+  const bool one_vector = p.end_source == p.begin_source && p.end_target == p.begin_target;
+  if (!p.pinned_last && !one_vector) from.push_back(p.end_source), to.push_back(p.end_target);
+  Points2 starts(n + static_cast<Index>(from.size()), 2);
+  starts.topRows(n) = p.starts;
+  for (std::size_t e = 0; e < from.size(); ++e) starts.row(n + static_cast<Index>(e)) = from[e].transpose();
+  // The path's ends and an exact count of its crossings.
   std::vector<double> coarse_t;
   double energy = 0.0;
-  for (auto level_rows = levels.rbegin(); level_rows != levels.rend(); ++level_rows) {
-    Level level;
-    level.rows = *level_rows;
-    const Index count = static_cast<Index>(level.rows.size());
-    level.samples = std::max(4 * (count + 1), (finest * (count + 1) + n) / (n + 1));
-    const double per_sample = p.target_length / static_cast<double>(level.samples);
-    const std::vector<double> centre =
-        coarse_rows.empty() ? std::vector<double>() : carry(p, coarse_rows, coarse_t, level.rows);
-    Index band = std::max<Index>(16, 8 * level.samples / (count + 1));
-    std::vector<Index> path;
-    for (;;) {
-      level.lo.resize(count), level.hi.resize(count);
-      for (Index r = 0; r < count; ++r) {
-        auto [lo, hi] = feasible(p, r, count, level.samples);
-        if (!centre.empty() && band < level.samples) {
-          const Index c = static_cast<Index>(std::llround(centre[r] / per_sample));
-          lo = std::max(lo, c - band), hi = std::min(hi, c + band);
-        }
-        level.lo[r] = lo, level.hi[r] = hi;
-      }
-      if (solve_level(p, level, path, energy)) break;
-      if (centre.empty() || band >= level.samples) {
-        throw GeometryError("optimal: no monotone matching (more start points than the target can separate)");
-      }
-      band *= 2;
+  auto take = [&] {
+    for (Index r = 0; r < n; ++r) {
+      match.arcs[r] = coarse_t[r];
+      match.points.row(r) = curve.point_at(coarse_t[r]).transpose();
     }
-    coarse_rows = level.rows;
-    coarse_t.resize(count);
-    for (Index r = 0; r < count; ++r) coarse_t[r] = per_sample * path[r];
+    if (p.pinned_first) match.points.row(0) = p.begin_target.transpose();
+    if (p.pinned_last) match.points.row(n - 1) = p.end_target.transpose();
+    match.energy = energy;
+    Points2 ends(starts.rows(), 2);
+    ends.topRows(n) = match.points;
+    for (std::size_t e = 0; e < to.size(); ++e) ends.row(n + static_cast<Index>(e)) = to[e].transpose();
+    return count_crossings(starts, ends);
+  };
+
+  // With the region: crossing-free by construction where it is a simple polygon (or the cut ring);
+  // where it is not, its vectors are still the likeliest to be free of crossings. Without a path
+  // inside it, the penalised one. Every result is counted exactly (the line queries round at 1e-9
+  // of a vector's length) and returned only without crossings.
+  const bool free_rows = n > static_cast<Index>(p.pinned_first) + static_cast<Index>(p.pinned_last);
+  std::unique_ptr<MatchRegion> region;
+  std::string why_not;
+  Index crossings = 0;
+  bool inside = false;
+  if (free_rows) {
+    region = std::make_unique<MatchRegion>(source, target);
+    why_not = region->why_not();
+    p.region = region.get();
+    inside = solve_levels(p, levels, finest, start_rows, coarse_t, energy);
+    if (inside) crossings = take();
+  } else {
+    solve_levels(p, levels, finest, start_rows, coarse_t, energy);
+    crossings = take();
   }
-  for (Index r = 0; r < n; ++r) {
-    match.arcs[r] = coarse_t[r];
-    match.points.row(r) = curve.point_at(coarse_t[r]).transpose();
+  match.by_construction = inside && why_not.empty() && crossings == 0;
+  if (free_rows && (!inside || crossings > 0)) {
+    if (why_not.empty()) {
+      why_not = inside ? "the vectors inside the region cross by rounding"
+                       : "no path of vectors inside the region between them was found at the matching's sampling";
+    }
+    p.region = nullptr;
+    solve_levels(p, levels, finest, start_rows, coarse_t, energy);
+    crossings = take();
   }
-  if (p.pinned_first) match.points.row(0) = p.begin_target.transpose();
-  if (p.pinned_last) match.points.row(n - 1) = p.end_target.transpose();
-  match.energy = energy;
+  if (crossings > 0) {
+    throw GeometryError("optimal: no crossing-free order-preserving matching of a pair of pieces (" +
+                        (why_not.empty() ? std::string("its ends are fixed") : why_not) +
+                        "; the matching without that constraint has " + std::to_string(crossings) +
+                        " crossing pairs); method 'best' keeps the best crossing-free candidate");
+  }
   return match;
 }
 
