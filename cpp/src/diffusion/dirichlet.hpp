@@ -6,6 +6,7 @@
 #include <morphomap/types.hpp>
 
 #include "common/interrupt_check.hpp"
+#include "diffusion/block_cg.hpp"
 #include "diffusion/multifrontal.hpp"
 #include "diffusion/nested_dissection.hpp"
 
@@ -28,8 +29,6 @@ namespace morphomap::detail {
 
 // crossing_vertex: on both surfaces, where they cross; c = 0 there.
 enum Kind : char { free_vertex = 0, source_vertex = 1, target_vertex = 2, crossing_vertex = 3 };
-
-constexpr Index kIterationsPerRound = 100;
 
 // The P1 stiffness matrix of a triangle: grad phi_i . grad phi_j * area (orientation-free).
 inline Eigen::Matrix3d triangle_stiffness(const Vec2 (&p)[3]) {
@@ -103,10 +102,10 @@ Eigen::MatrixXd solve_direct(Eigen::SparseMatrix<double> stiffness, const Eigen:
 // The discrete harmonic function of each column of `values`: at the vertices where `fixed` is
 // set, the given values; at the others, the P1 solution of the Laplace equation. elements:
 // (E, K) vertex indices; local(e) returns element e's K x K stiffness matrix. With iterative,
-// conjugate gradients with an incomplete Cholesky preconditioner come first (less memory and
-// time for 3D meshes), to the relative residual `tolerance`, the sparse LDL^T factorisation
-// otherwise or as the fallback. With `positions` (a row per vertex), the factorisation is the
-// multifrontal Cholesky along a nested dissection of them (multifrontal.hpp; dense blocks, all
+// conjugate gradients with an incomplete Cholesky preconditioner come first, every column at
+// once (block_cg.hpp; less memory and time for 3D meshes), to the relative residual
+// `tolerance`, the sparse LDL^T factorisation otherwise or as the fallback. With `positions` (a row per vertex), the
+// factorisation is the multifrontal Cholesky along a nested dissection of them (multifrontal.hpp; dense blocks, all
 // cores) rather than Eigen's simplicial LDL^T in its AMD order.
 template <class Elements, class Local>
 Eigen::MatrixXd solve_dirichlet_values(Index vertex_count, const Elements& elements, const std::vector<char>& fixed,
@@ -142,25 +141,7 @@ Eigen::MatrixXd solve_dirichlet_values(Index vertex_count, const Elements& eleme
   Eigen::MatrixXd x(free_count, values.cols());
   bool solved = false;
   if (iterative) {
-    Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
-                             Eigen::IncompleteCholesky<double>>
-        cg;
-    cg.setTolerance(tolerance);
-    cg.compute(stiffness);
-    solved = cg.info() == Eigen::Success;
-    // In rounds of iterations, each continuing from the last, so that an interrupt is seen.
-    const Index budget = std::max<Index>(1000, free_count);
-    cg.setMaxIterations(kIterationsPerRound);
-    for (Index column = 0; solved && column < values.cols(); ++column) {
-      Vector xc = Vector::Zero(free_count);
-      for (Index done = 0; done < budget; done += kIterationsPerRound) {
-        check_interrupt();
-        xc = cg.solveWithGuess(rhs.col(column), xc);
-        if (cg.info() != Eigen::NoConvergence) break;
-      }
-      solved = cg.info() == Eigen::Success && xc.allFinite();
-      x.col(column) = xc;
-    }
+    solved = solve_block_cg(stiffness, rhs, tolerance, std::max<Index>(1000, free_count), x);
   }
   if (!solved && positions.rows() == vertex_count) {
     Eigen::MatrixXd free_positions(free_count, positions.cols());
