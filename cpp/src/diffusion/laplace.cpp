@@ -322,12 +322,30 @@ class Tracer {
   Index step_limit_ = 0;
 };
 
+// Meshing squares lengths: keep them far from overflow and underflow. Diffusion's own rule (the
+// mapping does not check it), and the first after require_curve: the other checks square lengths too.
+void require_in_range(const Points2Ref& points, Index rows, const char* name) {
+  const auto p = points.topRows(rows);
+  const double far = p.cwiseAbs().maxCoeff();
+  const double extent = (p.colwise().maxCoeff() - p.colwise().minCoeff()).norm();
+  if (!(far <= 1e100) || !(extent >= 1e-100)) {
+    detail::invalid(name,
+                    "diffusion mapping needs coordinates within 1e100 of the origin and a curve "
+                    "wider than 1e-100 (rescale the curves)");
+  }
+}
+
+DiffusionSolution solve(const Points2Ref& source_points, const Points2Ref& target_points, bool closed,
+                        const DiffusionOptions& options);
+
 }  // namespace
 
 DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2Ref& target_points, bool closed,
                                   const DiffusionOptions& options) {
   const Index ns = detail::require_curve(source_points, closed, "c1");
   const Index nt = detail::require_curve(target_points, closed, "c2");
+  require_in_range(source_points, ns, "c1");
+  require_in_range(target_points, nt, "c2");
   // The region between the curves is only defined for simple ones.
   detail::require_no_self_intersection(source_points.topRows(ns), closed, "c1");
   detail::require_no_self_intersection(target_points.topRows(nt), closed, "c2");
@@ -336,25 +354,23 @@ DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2
     detail::require_area(target_points.topRows(nt), "c2");
   }
   detail::require_diffusion_options(options);
-  return detail::solve_diffusion_unchecked(source_points, target_points, closed, options);
+  return solve(source_points, target_points, closed, options);
 }
 
 DiffusionSolution detail::solve_diffusion_unchecked(const Points2Ref& source_points, const Points2Ref& target_points,
                                                     bool closed, const DiffusionOptions& options) {
+  require_in_range(source_points, curve_size(source_points, closed), "c1");
+  require_in_range(target_points, curve_size(target_points, closed), "c2");
+  return solve(source_points, target_points, closed, options);
+}
+
+namespace {
+
+// solve_diffusion on checked curves and options.
+DiffusionSolution solve(const Points2Ref& source_points, const Points2Ref& target_points, bool closed,
+                        const DiffusionOptions& options) {
   const Index ns = detail::curve_size(source_points, closed);
   const Index nt = detail::curve_size(target_points, closed);
-  // Meshing squares lengths: keep them far from overflow and underflow.
-  for (const auto& [points, rows, name] :
-       {std::tuple(&source_points, ns, "c1"), std::tuple(&target_points, nt, "c2")}) {
-    const auto p = points->topRows(rows);
-    const double far = p.cwiseAbs().maxCoeff();
-    const double extent = (p.colwise().maxCoeff() - p.colwise().minCoeff()).norm();
-    if (!(far <= 1e100) || !(extent >= 1e-100)) {
-      detail::invalid(name,
-                      "diffusion mapping needs coordinates within 1e100 of the origin and a curve "
-                      "wider than 1e-100 (rescale the curves)");
-    }
-  }
   const Points2 source = source_points.topRows(ns), target = target_points.topRows(nt);
 
   // Boundary loops; input points are numbered source first, then target.
@@ -489,5 +505,7 @@ DiffusionSolution detail::solve_diffusion_unchecked(const Points2Ref& source_poi
   solution.triangles = mesh.triangles;
   return solution;
 }
+
+}  // namespace
 
 }  // namespace morphomap
