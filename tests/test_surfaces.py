@@ -158,6 +158,19 @@ def test_closest_points_equal_brute_force(rng):
     assert np.abs(np.einsum("ij,ij->i", hits.points - a, n / np.linalg.norm(n, axis=1)[:, None])).max() < 1e-12
 
 
+def test_closest_points_on_shared_vertices_take_the_lowest_face(rng):
+    # A query on a vertex is at distance 0 from every face around it: the tie goes to the lowest
+    # face index, whatever order the faces come in (3D diffusion's start points rely on it).
+    v, f = ellipsoid(4)
+    for faces in (f, f[rng.permutation(len(f))], f[::-1]):
+        hits = mm.SurfaceIndex(v, faces).closest_points(v)
+        lowest = np.full(len(v), len(faces))
+        for k in range(3):
+            np.minimum.at(lowest, faces[:, k], np.arange(len(faces)))
+        assert (hits.distances == 0).all()
+        np.testing.assert_array_equal(hits.faces, lowest)
+
+
 def test_surface_normals_of_a_sphere(sphere):
     v, f = sphere
     normals = mm.surface_normals(v, f)

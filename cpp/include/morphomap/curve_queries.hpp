@@ -15,6 +15,10 @@ struct CurveHits {
   Vector arc_lengths;    // arc-length parameter of the point, measured from the first point
 };
 
+namespace detail {
+struct CurveIndexUnchecked;  // the core's unchecked access, for curves it checked at its entry
+}
+
 // A polyline with a bounding-volume hierarchy over its segments, built once and queried many
 // times from all cores. Zero-length segments are allowed (a repeated point).
 class CurveIndex {
@@ -35,7 +39,9 @@ class CurveIndex {
   bool closed() const;
 
  private:
+  friend struct detail::CurveIndexUnchecked;
   struct Impl;
+  explicit CurveIndex(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };
 

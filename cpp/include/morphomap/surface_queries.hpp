@@ -22,7 +22,8 @@ class SurfaceIndex {
   SurfaceIndex(SurfaceIndex&&) noexcept;
   SurfaceIndex& operator=(SurfaceIndex&&) noexcept;
 
-  // Closest point on the surface to each query point.
+  // Closest point on the surface to each query point (ties: the lowest face index, whatever the
+  // traversal or thread count).
   SurfaceHits closest_points(const Points3Ref& queries) const;
   // For each line origin + t * direction, t of either sign, the intersection with the surface
   // nearest to the origin, refined in double precision on the hit triangle.

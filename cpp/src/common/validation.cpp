@@ -1,6 +1,6 @@
 #include "common/validation.hpp"
 
-#include <morphomap/curve_geometry.hpp>
+#include "curves/unchecked.hpp"
 
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
@@ -44,7 +44,12 @@ Index require_curve(const Points2Ref& points, bool closed, const char* name) {
 }
 
 Points2 without_repeats(const Points2Ref& points, bool closed, const char* name) {
-  const Index n = require_curve(points, closed, name);
+  require_curve(points, closed, name);
+  return drop_repeats(points, closed, name);
+}
+
+Points2 drop_repeats(const Points2Ref& points, bool closed, const char* name) {
+  const Index n = curve_size(points, closed);
   Points2 out(n, 2);
   Index m = 0;
   for (Index i = 0; i < n; ++i) {
@@ -63,8 +68,8 @@ Points2 without_repeats(const Points2Ref& points, bool closed, const char* name)
 }
 
 void require_area(const Points2Ref& points, const char* name) {
-  const double length = perimeter(points, true);
-  if (!(std::abs(signed_area(points)) > 1e-14 * length * length)) {
+  const double length = perimeter_unchecked(points, true);
+  if (!(std::abs(signed_area_unchecked(points)) > 1e-14 * length * length)) {
     invalid(name, "the closed curve encloses zero area");
   }
 }
@@ -72,7 +77,7 @@ void require_area(const Points2Ref& points, const char* name) {
 Points2 oriented_closed_curve(const Points2Ref& points, const char* name, int& turn) {
   Points2 q = without_repeats(points, true, name);
   try {
-    turn = orientation(q);
+    turn = orientation_unchecked(q);
   } catch (const InvalidInput&) {
     invalid(name, "the closed curve encloses zero area");
   }

@@ -38,6 +38,8 @@ Index require_curve(const Points2Ref& points, bool closed, const char* name);
 // The curve without exact consecutive repeats (nor a closing repeat when closed), checked to
 // still have enough points.
 Points2 without_repeats(const Points2Ref& points, bool closed, const char* name);
+// without_repeats for a curve that passed require_curve already.
+Points2 drop_repeats(const Points2Ref& points, bool closed, const char* name);
 
 // A closed curve (as checked by require_curve) whose area is not (nearly) zero against the square
 // of its length: no orientation to trust, no region to mesh otherwise.
@@ -53,8 +55,8 @@ Points2 oriented_closed_curve(const Points2Ref& points, const char* name, int& t
 // and where. Returns curve_size.
 Index require_simple_curve(const Points2Ref& points, bool closed, const char* name);
 
-// The curve, with consecutive repeats dropped, meets itself: InvalidInput naming `name`, with
-// the number of pairs of segments that meet and the first of them.
+// The curve (as checked by require_curve), with consecutive repeats dropped, meets itself:
+// InvalidInput naming `name`, with the number of pairs of segments that meet and the first of them.
 void require_no_self_intersection(const Points2Ref& points, bool closed, const char* name);
 
 // A closed surface's signed volume (check_closed_surface) is positive: its faces face outwards.

@@ -8,8 +8,14 @@
 
 namespace morphomap::detail {
 
-ArcCurve::ArcCurve(const Points2Ref& points, bool closed, const char* name) : closed_(closed) {
-  const Index n = require_curve(points, closed, name);
+ArcCurve::ArcCurve(const Points2Ref& points, bool closed, const char* name)
+    : ArcCurve(points, closed, require_curve(points, closed, name)) {}
+
+ArcCurve ArcCurve::unchecked(const Points2Ref& points, bool closed) {
+  return ArcCurve(points, closed, curve_size(points, closed));
+}
+
+ArcCurve::ArcCurve(const Points2Ref& points, bool closed, Index n) : closed_(closed) {
   points_ = points.topRows(n);
   arc_.resize(n + 1);
   arc_[0] = 0.0;

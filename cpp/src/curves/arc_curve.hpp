@@ -8,6 +8,8 @@ class ArcCurve {
  public:
   // The curve as checked by require_curve (a closing duplicate is dropped; repeats are kept).
   ArcCurve(const Points2Ref& points, bool closed, const char* name);
+  // A curve that passed require_curve already (at its caller's entry).
+  static ArcCurve unchecked(const Points2Ref& points, bool closed);
 
   const Points2& points() const { return points_; }
   bool closed() const { return closed_; }
@@ -34,6 +36,8 @@ class ArcCurve {
   Index vertex_after(double s) const;
 
  private:
+  ArcCurve(const Points2Ref& points, bool closed, Index n);
+
   Points2 points_;
   Vector arc_;  // size() + 1 entries
   bool closed_;

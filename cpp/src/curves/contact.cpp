@@ -1,5 +1,7 @@
 #include "curves/contact.hpp"
 
+#include "curves/unchecked.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -51,12 +53,14 @@ double default_contact_tolerance(const ArcCurve& source, const ArcCurve& target)
   return 0.01 * std::min(median_segment(source), median_segment(target));
 }
 
-std::vector<Meeting> find_meetings(const ArcCurve& source, const ArcCurve& target, const CurveIntersections& crossings,
+std::vector<Meeting> find_meetings(const ArcCurve& source, const ArcCurve& target, const CurveIndex& source_index,
+                                   const CurveIndex& target_index, const CurveIntersections& crossings,
                                    double tolerance) {
   const Index n = source.size();
   const bool closed = source.closed();
-  const CurveHits to_target = CurveIndex(target.points(), target.closed()).closest_points(source.points());
-  const CurveHits to_source = CurveIndex(source.points(), closed).closest_points(target.points());
+  // The points of checked curves are finite: no query to check.
+  const CurveHits to_target = CurveIndexUnchecked::closest_points(target_index, source.points());
+  const CurveHits to_source = CurveIndexUnchecked::closest_points(source_index, target.points());
   std::vector<char> near_source(n), near_target(target.size());
   for (Index i = 0; i < n; ++i) near_source[i] = to_target.distances[i] <= tolerance;
   for (Index j = 0; j < target.size(); ++j) near_target[j] = to_source.distances[j] <= tolerance;

@@ -32,8 +32,10 @@ double default_contact_tolerance(const ArcCurve& source, const ArcCurve& target)
 // source vertices within `tolerance` of the target, consecutive ones joined where the target
 // between their closest points also stays within `tolerance` of the source (so a run does not
 // jump across a gap); a single such vertex is a touching point. Crossings that lie on a stretch
-// (within the tolerance) belong to it; the others are meetings of their own.
-std::vector<Meeting> find_meetings(const ArcCurve& source, const ArcCurve& target, const CurveIntersections& crossings,
+// (within the tolerance) belong to it; the others are meetings of their own. The indexes are
+// those of the two curves (the caller's, built once per call).
+std::vector<Meeting> find_meetings(const ArcCurve& source, const ArcCurve& target, const CurveIndex& source_index,
+                                   const CurveIndex& target_index, const CurveIntersections& crossings,
                                    double tolerance);
 
 // The meetings whose target positions follow each other along the target in `direction`

@@ -3,6 +3,7 @@
 #include "common/distinct_points.hpp"
 #include "common/segment_pairs.hpp"
 #include "common/validation.hpp"
+#include "curves/unchecked.hpp"
 
 #include <CGAL/Interval_nt.h>
 #include <CGAL/MP_Float.h>
@@ -54,15 +55,37 @@ Vector arc_lengths(const Points2Ref& points, bool closed) {
 }
 
 double perimeter(const Points2Ref& points, bool closed) {
-  const Index n = detail::require_curve(points, closed, "points");
+  detail::require_curve(points, closed, "points");
+  return detail::perimeter_unchecked(points, closed);
+}
+
+double signed_area(const Points2Ref& points) {
+  detail::require_curve(points, true, "points");
+  return detail::signed_area_unchecked(points);
+}
+
+int orientation(const Points2Ref& points) {
+  detail::require_curve(points, true, "points");
+  return detail::orientation_unchecked(points);
+}
+
+Points2 normals(const Points2Ref& points, bool closed) {
+  detail::require_curve(points, closed, "points");
+  return detail::normals_unchecked(points, closed);
+}
+
+namespace detail {
+
+double perimeter_unchecked(const Points2Ref& points, bool closed) {
+  const Index n = curve_size(points, closed);
   double length = 0.0;
   for (Index i = 1; i < n; ++i) length += distance(points, i - 1, i);
   if (closed) length += distance(points, n - 1, 0);
   return length;
 }
 
-double signed_area(const Points2Ref& points) {
-  const Index n = detail::require_curve(points, true, "points");
+double signed_area_unchecked(const Points2Ref& points) {
+  const Index n = curve_size(points, true);
   // Relative to the first point, so that a curve far from the origin loses no digits.
   const double x0 = points(0, 0), y0 = points(0, 1);
   double twice = 0.0;
@@ -72,14 +95,11 @@ double signed_area(const Points2Ref& points) {
   return 0.5 * twice;
 }
 
-int orientation(const Points2Ref& points) {
-  const Index n = detail::require_curve(points, true, "points");
-  return closed_orientation(points, n);
-}
+int orientation_unchecked(const Points2Ref& points) { return closed_orientation(points, curve_size(points, true)); }
 
-Points2 normals(const Points2Ref& points, bool closed) {
-  const Points2 q = detail::without_repeats(points, closed, "points");
-  const Index n = detail::curve_size(points, closed);
+Points2 normals_unchecked(const Points2Ref& points, bool closed) {
+  const Points2 q = drop_repeats(points, closed, "points");
+  const Index n = curve_size(points, closed);
   const Index m = q.rows();
   // Outward is to the right of travel on a counter-clockwise curve.
   const double side = closed ? closed_orientation(q, m) : 1.0;
@@ -114,6 +134,8 @@ Points2 normals(const Points2Ref& points, bool closed) {
   }
   return out;
 }
+
+}  // namespace detail
 
 namespace {
 
@@ -152,7 +174,7 @@ bool is_self_intersecting(const Points2Ref& points, bool closed) {
 namespace detail {
 
 void require_no_self_intersection(const Points2Ref& points, bool closed, const char* name) {
-  const Points2 q = without_repeats(points, closed, name);
+  const Points2 q = drop_repeats(points, closed, name);
   IndexPairs pairs;
   const Index count = self_intersecting_pairs(q, closed, &pairs);
   if (count == 0) return;

@@ -4,6 +4,7 @@
 
 #include "common/validation.hpp"
 #include "curves/curve_tree.hpp"
+#include "curves/unchecked.hpp"
 
 namespace morphomap {
 
@@ -24,7 +25,9 @@ CurveHits allocate_hits(Index rows) {
 
 }  // namespace
 
-CurveIndex::CurveIndex(const Points2Ref& curve, bool closed) : impl_(std::make_unique<Impl>(curve, closed)) {}
+CurveIndex::CurveIndex(const Points2Ref& curve, bool closed)
+    : impl_(std::make_unique<Impl>(curve, closed, detail::require_curve(curve, closed, "curve"))) {}
+CurveIndex::CurveIndex(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 CurveIndex::~CurveIndex() = default;
 CurveIndex::CurveIndex(CurveIndex&&) noexcept = default;
 CurveIndex& CurveIndex::operator=(CurveIndex&&) noexcept = default;
@@ -34,17 +37,30 @@ bool CurveIndex::closed() const { return impl_->closed; }
 
 CurveHits CurveIndex::closest_points(const Points2Ref& queries) const {
   detail::require_finite(queries, "queries");
-  CurveHits hits = allocate_hits(queries.rows());
-  impl_->closest_points(queries, hits);
-  return hits;
+  return detail::CurveIndexUnchecked::closest_points(*this, queries);
 }
 
 CurveHits CurveIndex::line_intersections(const Points2Ref& origins, const Points2Ref& directions) const {
   detail::require_finite(origins, "origins");
   detail::require_finite(directions, "directions");
   detail::require_directions(origins, directions);
+  return detail::CurveIndexUnchecked::line_intersections(*this, origins, directions);
+}
+
+CurveIndex detail::CurveIndexUnchecked::build(const Points2Ref& curve, bool closed) {
+  return CurveIndex(std::make_unique<CurveIndex::Impl>(curve, closed, curve_size(curve, closed)));
+}
+
+CurveHits detail::CurveIndexUnchecked::closest_points(const CurveIndex& index, const Points2Ref& queries) {
+  CurveHits hits = allocate_hits(queries.rows());
+  index.impl_->closest_points(queries, hits);
+  return hits;
+}
+
+CurveHits detail::CurveIndexUnchecked::line_intersections(const CurveIndex& index, const Points2Ref& origins,
+                                                          const Points2Ref& directions) {
   CurveHits hits = allocate_hits(origins.rows());
-  impl_->line_intersections(origins, directions, hits);
+  index.impl_->line_intersections(origins, directions, hits);
   return hits;
 }
 

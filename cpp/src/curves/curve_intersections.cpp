@@ -4,6 +4,7 @@
 #include "common/numbers.hpp"
 #include "common/segment_pairs.hpp"
 #include "common/validation.hpp"
+#include "curves/unchecked.hpp"
 
 #include <CGAL/Exact_rational.h>
 
@@ -28,7 +29,9 @@ struct Curve {
   std::vector<Index> segment;  // input segment index of each segment
   Index segments;
 
-  Curve(const Points2Ref& points, bool closed, const char* name) : q(detail::without_repeats(points, closed, name)) {
+  // `checked`: the points passed require_curve already.
+  Curve(const Points2Ref& points, bool closed, const char* name, bool checked)
+      : q(checked ? detail::drop_repeats(points, closed, name) : detail::without_repeats(points, closed, name)) {
     const Index m = q.rows();
     segments = closed ? m : m - 1;
     p.resize(m);
@@ -183,10 +186,7 @@ std::vector<Index> drop_touches(const Curve& c1, const Curve& c2, const std::vec
   return order;
 }
 
-}  // namespace
-
-CurveIntersections curve_intersections(const Points2Ref& c1, const Points2Ref& c2, bool closed) {
-  const Curve a(c1, closed, "c1"), b(c2, closed, "c2");
+CurveIntersections intersections(const Curve& a, const Curve& b, bool closed) {
   detail::IndexPairs hits;
   detail::test_overlapping_pairs(
       a.boxes(), b.boxes(), [&](Index i, Index j) { return shifted_cross(a, i, b, j); }, &hits);
@@ -216,6 +216,18 @@ CurveIntersections curve_intersections(const Points2Ref& c1, const Points2Ref& c
     out.segments2(r) = b.segment[c.seg2];
   }
   return out;
+}
+
+}  // namespace
+
+CurveIntersections curve_intersections(const Points2Ref& c1, const Points2Ref& c2, bool closed) {
+  const Curve a(c1, closed, "c1", false), b(c2, closed, "c2", false);
+  return intersections(a, b, closed);
+}
+
+CurveIntersections detail::curve_intersections_unchecked(const Points2Ref& c1, const Points2Ref& c2, bool closed) {
+  const Curve a(c1, closed, "c1", true), b(c2, closed, "c2", true);
+  return intersections(a, b, closed);
 }
 
 }  // namespace morphomap

@@ -122,8 +122,9 @@ struct Tree {
   std::vector<Group> groups;
   double centre_x = 0.0, centre_y = 0.0, scale = 1.0;
 
-  // Builds the tree (curve_tree_build.cpp).
-  Tree(const Points2Ref& curve, bool is_closed);
+  // Builds the tree (curve_tree_build.cpp) over the first `size` rows of a curve that passed
+  // require_curve (which returns that size).
+  Tree(const Points2Ref& curve, bool is_closed, Index size);
 
   // Median split on the longer axis of the centroid box; segments are reordered in place.
   std::int32_t split(std::int32_t begin, std::int32_t end);

@@ -10,8 +10,7 @@
 
 namespace morphomap::curve_tree {
 
-Tree::Tree(const Points2Ref& curve, bool is_closed) : closed(is_closed) {
-  points = detail::require_curve(curve, closed, "curve");
+Tree::Tree(const Points2Ref& curve, bool is_closed, Index size) : points(size), closed(is_closed) {
   const Index count = closed ? points : points - 1;
   if (count >= std::numeric_limits<std::int32_t>::max()) {
     detail::invalid("curve", "too many points for the index (at most 2^31 - 2 segments)");

@@ -93,7 +93,8 @@ void keep_faces_facing(const Points3Ref& before, const FacesRef& faces, Points3&
 
 ClearedSource clear_contact(const Points3Ref& source_vertices, const FacesRef& source_faces,
                             const Points3Ref& target_vertices, const FacesRef& target_faces,
-                            const SurfaceIndex& target_index, double clearance, double tolerance) {
+                            const ClosedSurface& target_surface, const SurfaceIndex& target_index, double clearance,
+                            double tolerance) {
   const Index n = source_vertices.rows();
   const SurfaceHits hits = target_index.closest_points(source_vertices);
   ClearedSource cleared;
@@ -137,7 +138,7 @@ ClearedSource clear_contact(const Points3Ref& source_vertices, const FacesRef& s
   }
   Points3 queries(static_cast<Index>(asked.size()), 3);
   for (std::size_t k = 0; k < asked.size(); ++k) queries.row(static_cast<Index>(k)) = source_vertices.row(asked[k]);
-  const std::vector<char> inside_answers = inside_surface(target_vertices, target_faces, queries);
+  const std::vector<char> inside_answers = inside_surface(target_surface, queries);
   std::vector<char> inside(static_cast<std::size_t>(n), 0);
   for (std::size_t k = 0; k < asked.size(); ++k) inside[asked[k]] = inside_answers[k];
 

@@ -8,6 +8,8 @@
 #include <morphomap/surface_queries.hpp>
 #include <morphomap/types.hpp>
 
+#include "diffusion/shell_mesh.hpp"
+
 #include <vector>
 
 namespace morphomap::detail {
@@ -20,7 +22,8 @@ struct ClearedSource {
   double near_area = 0.0;      // of the source faces whose corners all lie within the clearance
 };
 
-// Source and target closed and outward-oriented; `target_index` built from the target. Every
+// Source and target closed and outward-oriented; `target_surface` and `target_index` built from
+// the target. Every
 // connected patch of source vertices closer than `clearance` to the target is pulled back along
 // the source's normals until it lies about `clearance` from the target, on the side of the target
 // where the patch's surroundings (its ring of farther vertices) lie. A patch whose surroundings lie
@@ -29,6 +32,7 @@ struct ClearedSource {
 // everywhere, InvalidInput.
 ClearedSource clear_contact(const Points3Ref& source_vertices, const FacesRef& source_faces,
                             const Points3Ref& target_vertices, const FacesRef& target_faces,
-                            const SurfaceIndex& target_index, double clearance, double tolerance);
+                            const ClosedSurface& target_surface, const SurfaceIndex& target_index, double clearance,
+                            double tolerance);
 
 }  // namespace morphomap::detail

@@ -9,7 +9,9 @@
 #include "common/numbers.hpp"
 #include "common/validation.hpp"
 #include "curves/inside.hpp"
+#include "curves/unchecked.hpp"
 #include "diffusion/dirichlet.hpp"
+#include "diffusion/laplace_unchecked.hpp"
 #include "diffusion/region_mesh.hpp"
 
 #include <tbb/parallel_for.h>
@@ -320,24 +322,30 @@ class Tracer {
   Index step_limit_ = 0;
 };
 
+// Meshing squares lengths: keep them far from overflow and underflow. Diffusion's own rule (the
+// mapping does not check it), and the first after require_curve: the other checks square lengths too.
+void require_in_range(const Points2Ref& points, Index rows, const char* name) {
+  const auto p = points.topRows(rows);
+  const double far = p.cwiseAbs().maxCoeff();
+  const double extent = (p.colwise().maxCoeff() - p.colwise().minCoeff()).norm();
+  if (!(far <= 1e100) || !(extent >= 1e-100)) {
+    detail::invalid(name,
+                    "diffusion mapping needs coordinates within 1e100 of the origin and a curve "
+                    "wider than 1e-100 (rescale the curves)");
+  }
+}
+
+DiffusionSolution solve(const Points2Ref& source_points, const Points2Ref& target_points, bool closed,
+                        const DiffusionOptions& options);
+
 }  // namespace
 
 DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2Ref& target_points, bool closed,
                                   const DiffusionOptions& options) {
   const Index ns = detail::require_curve(source_points, closed, "c1");
   const Index nt = detail::require_curve(target_points, closed, "c2");
-  // Meshing squares lengths: keep them far from overflow and underflow.
-  for (const auto& [points, rows, name] :
-       {std::tuple(&source_points, ns, "c1"), std::tuple(&target_points, nt, "c2")}) {
-    const auto p = points->topRows(rows);
-    const double far = p.cwiseAbs().maxCoeff();
-    const double extent = (p.colwise().maxCoeff() - p.colwise().minCoeff()).norm();
-    if (!(far <= 1e100) || !(extent >= 1e-100)) {
-      detail::invalid(name,
-                      "diffusion mapping needs coordinates within 1e100 of the origin and a curve "
-                      "wider than 1e-100 (rescale the curves)");
-    }
-  }
+  require_in_range(source_points, ns, "c1");
+  require_in_range(target_points, nt, "c2");
   // The region between the curves is only defined for simple ones.
   detail::require_no_self_intersection(source_points.topRows(ns), closed, "c1");
   detail::require_no_self_intersection(target_points.topRows(nt), closed, "c2");
@@ -346,13 +354,30 @@ DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2
     detail::require_area(target_points.topRows(nt), "c2");
   }
   detail::require_diffusion_options(options);
+  return solve(source_points, target_points, closed, options);
+}
+
+DiffusionSolution detail::solve_diffusion_unchecked(const Points2Ref& source_points, const Points2Ref& target_points,
+                                                    bool closed, const DiffusionOptions& options) {
+  require_in_range(source_points, curve_size(source_points, closed), "c1");
+  require_in_range(target_points, curve_size(target_points, closed), "c2");
+  return solve(source_points, target_points, closed, options);
+}
+
+namespace {
+
+// solve_diffusion on checked curves and options.
+DiffusionSolution solve(const Points2Ref& source_points, const Points2Ref& target_points, bool closed,
+                        const DiffusionOptions& options) {
+  const Index ns = detail::curve_size(source_points, closed);
+  const Index nt = detail::curve_size(target_points, closed);
   const Points2 source = source_points.topRows(ns), target = target_points.topRows(nt);
 
   // Boundary loops; input points are numbered source first, then target.
   std::vector<Points2> loops;
   bool crossing = false;
   if (closed) {
-    crossing = curve_intersections(source, target, true).points.rows() > 0;
+    crossing = detail::curve_intersections_unchecked(source, target, true).points.rows() > 0;
     if (!crossing && !detail::inside(source.row(0).transpose(), target) &&
         !detail::inside(target.row(0).transpose(), source)) {
       detail::invalid("c2", "diffusion mapping needs one curve inside the other, or crossing curves");
@@ -381,12 +406,13 @@ DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2
     // their symmetric difference (an annulus when nested); of open ones, the loop that joins them.
     double area = 0.0;
     if (closed) {
-      const double a1 = std::abs(signed_area(source)), a2 = std::abs(signed_area(target));
+      const double a1 = std::abs(detail::signed_area_unchecked(source)),
+                   a2 = std::abs(detail::signed_area_unchecked(target));
       area = crossing ? a1 + a2 - 2.0 * overlap_area(source, target) : std::abs(a1 - a2);
     } else {
-      area = std::abs(signed_area(loops[0]));
+      area = std::abs(signed_area(loops[0]));  // a new curve: checked here
     }
-    const double boundary = perimeter(source, closed) + perimeter(target, closed);
+    const double boundary = detail::perimeter_unchecked(source, closed) + detail::perimeter_unchecked(target, closed);
     // A long thin region (a piece between two contact stretches, say) would get length / gap
     // times the vertices of a round one of the same gap: the lattice is kept within a budget of
     // vertices (at 20 per curve point, 40000 at least), still 20 or more across such a gap.
@@ -402,7 +428,8 @@ DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2
   // Dirichlet vertices: the input points, and the points the mesher added on the curves.
   const Index nv = mesh.vertices.rows();
   std::vector<char> kind(nv, free_vertex);
-  const CurveIndex on_source(source, closed), on_target(target, closed);
+  const CurveIndex on_source = detail::CurveIndexUnchecked::build(source, closed);
+  const CurveIndex on_target = detail::CurveIndexUnchecked::build(target, closed);
   const double scale = (mesh.vertices.colwise().maxCoeff() - mesh.vertices.colwise().minCoeff()).norm();
   const double tolerance = 1e-10 * scale;
   std::vector<Index> added;  // boundary vertices the mesher added: on which curve, found below
@@ -423,8 +450,8 @@ DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2
   Points2 added_points(static_cast<Index>(added.size()), 2);
   for (std::size_t k = 0; k < added.size(); ++k) added_points.row(static_cast<Index>(k)) = mesh.vertices.row(added[k]);
   detail::check_interrupt();
-  const Vector to_source = on_source.closest_points(added_points).distances;
-  const Vector to_target = on_target.closest_points(added_points).distances;
+  const Vector to_source = detail::CurveIndexUnchecked::closest_points(on_source, added_points).distances;
+  const Vector to_target = detail::CurveIndexUnchecked::closest_points(on_target, added_points).distances;
   for (std::size_t k = 0; k < added.size(); ++k) {
     const Index row = static_cast<Index>(k);
     if (to_target[row] <= tolerance)
@@ -448,7 +475,7 @@ DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2
   Points2 unstarted_points(static_cast<Index>(unstarted.size()), 2);
   for (std::size_t k = 0; k < unstarted.size(); ++k)
     unstarted_points.row(static_cast<Index>(k)) = source.row(unstarted[k]);
-  const Vector unstarted_to_target = on_target.closest_points(unstarted_points).distances;
+  const Vector unstarted_to_target = detail::CurveIndexUnchecked::closest_points(on_target, unstarted_points).distances;
   std::vector<char> on_target_already(ns, 0);
   for (std::size_t k = 0; k < unstarted.size(); ++k) {
     on_target_already[unstarted[k]] = unstarted_to_target[static_cast<Index>(k)] <= tolerance;
@@ -478,5 +505,7 @@ DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2
   solution.triangles = mesh.triangles;
   return solution;
 }
+
+}  // namespace
 
 }  // namespace morphomap

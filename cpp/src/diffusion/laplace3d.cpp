@@ -330,19 +330,22 @@ class Tracer {
 struct Cleared {
   detail::ClearedSource source;
   detail::Nesting nesting;
+  std::unique_ptr<const detail::ClosedSurface> surface;  // of the source when it moved (else none)
 };
 
 Cleared clear_and_classify(const Points3Ref& source_vertices, const FacesRef& source_faces,
                            const Points3Ref& target_vertices, const FacesRef& target_faces,
-                           const SurfaceIndex& target_index, double finer_edge, detail::Nesting nesting) {
+                           const detail::ClosedSurface& target_surface, const SurfaceIndex& target_index,
+                           double finer_edge, detail::Nesting nesting) {
   double fraction = kClearanceFraction;
   for (int attempt = 0;; ++attempt, fraction *= 0.5) {
-    Cleared cleared{detail::clear_contact(source_vertices, source_faces, target_vertices, target_faces, target_index,
-                                          fraction * finer_edge, kTouchFraction * finer_edge),
-                    nesting};
+    Cleared cleared{detail::clear_contact(source_vertices, source_faces, target_vertices, target_faces, target_surface,
+                                          target_index, fraction * finer_edge, kTouchFraction * finer_edge),
+                    nesting, nullptr};
     if (cleared.source.moved == 0) return cleared;
     try {
-      cleared.nesting = detail::classify_nesting(cleared.source.vertices, source_faces, target_vertices, target_faces);
+      cleared.surface = std::make_unique<const detail::ClosedSurface>(cleared.source.vertices, source_faces);
+      cleared.nesting = detail::classify_nesting(*cleared.surface, target_surface);
       return cleared;
     } catch (const InvalidInput&) {
       if (attempt == kClearanceAttempts - 1) {
@@ -388,7 +391,10 @@ ShellDiffusionSolution detail::solve_diffusion_3d(const Points3Ref& source_verti
   };
   stage("mesh");
   auto clock = std::chrono::steady_clock::now();
-  detail::Nesting nesting = detail::classify_nesting(source_vertices, source_out, target_vertices, target_out);
+  // Each surface in CGAL's form once, for the nesting, contact, crossing and meshing steps.
+  const detail::ClosedSurface given_source(source_vertices, source_out);
+  const detail::ClosedSurface target_surface(target_vertices, target_out);
+  detail::Nesting nesting = detail::classify_nesting(given_source, target_surface);
   if (nesting == detail::Nesting::disjoint) {
     throw InvalidInput("s2: diffusion mapping needs surfaces that overlap (these lie apart)");
   }
@@ -397,8 +403,8 @@ ShellDiffusionSolution detail::solve_diffusion_3d(const Points3Ref& source_verti
     own_target_index = std::make_unique<const SurfaceIndex>(target_vertices, target_faces);
   const SurfaceIndex& target_index = given_target_index ? *given_target_index : *own_target_index;
   const double finer_edge = std::min(source.mean_edge, target.mean_edge);
-  const Cleared cleared_pair =
-      clear_and_classify(source_vertices, source_out, target_vertices, target_out, target_index, finer_edge, nesting);
+  const Cleared cleared_pair = clear_and_classify(source_vertices, source_out, target_vertices, target_out,
+                                                  target_surface, target_index, finer_edge, nesting);
   const detail::ClearedSource& cleared = cleared_pair.source;
   nesting = cleared_pair.nesting;
   // Bodies that only touch from outside count as crossing until the contact is cleared.
@@ -409,9 +415,10 @@ ShellDiffusionSolution detail::solve_diffusion_3d(const Points3Ref& source_verti
   }
   // From here on the source is the cleared one: it bounds the region that is meshed and solved.
   const Points3& source_region = cleared.vertices;
+  const detail::ClosedSurface& source_surface = cleared_pair.surface ? *cleared_pair.surface : given_source;
   std::unique_ptr<detail::CrossingRegion> crossing;
   if (nesting == detail::Nesting::crossing) {
-    crossing = std::make_unique<detail::CrossingRegion>(source_region, source_out, target_vertices, target_out);
+    crossing = std::make_unique<detail::CrossingRegion>(source_surface, target_surface);
   }
 
   // Sizes: the input spacing at each surface, growing by a tenth of the distance from it, never
@@ -463,7 +470,7 @@ ShellDiffusionSolution detail::solve_diffusion_3d(const Points3Ref& source_verti
       mesh = detail::mesh_in_child(
           [&] {
             return crossing ? crossing->mesh(criteria)
-                            : detail::mesh_shell(source_region, source_out, target_vertices, target_out,
+                            : detail::mesh_shell(source_surface, target_surface,
                                                  nesting == detail::Nesting::source_inside, criteria);
           },
           "meshing the region between the surfaces");
@@ -509,7 +516,9 @@ ShellDiffusionSolution detail::solve_diffusion_3d(const Points3Ref& source_verti
     const int i = static_cast<int>(source_facets[k] % 4);
     for (int j = 1; j < 4; ++j) facets(static_cast<Index>(k), j - 1) = mesh.tetrahedra(t, (i + j) % 4);
   }
-  const detail::TriangleHits starts = detail::closest_on_triangles(mesh.vertices, facets, source_region);
+  // (A vertex on an edge or corner that several facets share takes the lowest facet, whatever
+  // the traversal: SurfaceIndex's tie rule, which keeps the ends repeatable bit for bit.)
+  const SurfaceHits starts = SurfaceIndex(mesh.vertices, facets).closest_points(source_region);
 
   const Tracer tracer(mesh, solution.potential, kind);
   const Index ns = source_vertices.rows();

@@ -2,6 +2,7 @@
 #include "diffusion/region_mesh.hpp"
 
 #include "common/interrupt_check.hpp"
+#include "curves/unchecked.hpp"
 
 #include <morphomap/curve_queries.hpp>
 #include <morphomap/errors.hpp>
@@ -150,7 +151,7 @@ std::vector<Point> clear_of_loops(const std::vector<CurveIndex>& loops, const st
   const Eigen::Map<const Points2> points(xy.data(), count, 2);
   std::vector<double> distance(away.size(), std::numeric_limits<double>::infinity());
   for (const CurveIndex& loop : loops) {
-    const CurveHits hits = loop.closest_points(points);
+    const CurveHits hits = CurveIndexUnchecked::closest_points(loop, points);  // lattice points: finite
     for (Index k = 0; k < count; ++k) distance[k] = std::min(distance[k], hits.distances[k]);
   }
   std::vector<Point> kept;
@@ -311,7 +312,7 @@ RegionMesh mesh_region(const std::vector<Points2>& loops, double max_edge) {
     if (cdt.dimension() < 2) throw GeometryError("the region between the curves is empty");
     if (max_edge > 0) {
       std::vector<CurveIndex> indexes;
-      for (const Points2& loop : loops) indexes.emplace_back(loop, true);
+      for (const Points2& loop : loops) indexes.push_back(CurveIndexUnchecked::build(loop, true));
       std::vector<Point> seeds = lattice_points(loops, indexes, kLattice * max_edge, kClearance);
       const std::size_t on_lattice = seeds.size();
       mark_odd_nesting(cdt);  // layer_points keeps the points on the region's side

@@ -16,6 +16,8 @@ struct RegionMesh {
   std::vector<char> on_boundary;  // mesh vertex on a constrained (boundary) edge
 };
 
+// The loops are closed curves that passed require_curve (their callers' checked curves, or a loop
+// made of such curves' points): they are not checked again here.
 // The region is the set of points inside an odd number of the loops (an annulus for two nested
 // loops, each lobe of the symmetric difference for two crossing ones). Every input point is a
 // mesh vertex. With max_edge > 0, the loops' edges are split to at most max_edge and a triangular

@@ -8,9 +8,6 @@
 
 #include <morphomap/errors.hpp>
 
-#include <CGAL/AABB_traits.h>
-#include <CGAL/AABB_tree.h>
-#include <CGAL/AABB_triangle_primitive.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Mesh_complex_3_in_triangulation_3.h>
 #include <CGAL/Mesh_criteria_3.h>
@@ -28,7 +25,7 @@
 #include <CGAL/boost/graph/properties_Surface_mesh_features.h>
 #include <CGAL/make_mesh_3.h>
 #include <CGAL/refine_mesh_3.h>
-#include <tbb/parallel_for.h>
+#include <boost/iterator/indirect_iterator.hpp>
 
 #include <algorithm>
 #include <array>
@@ -52,9 +49,6 @@ using Criteria = CGAL::Mesh_criteria_3<Triangulation>;
 using SearchTraits = CGAL::Search_traits_3<Kernel>;
 using Neighbour = CGAL::Orthogonal_k_neighbor_search<SearchTraits>;
 using PointTree = Neighbour::Tree;
-using Triangles = std::vector<Kernel::Triangle_3>;
-using SoupTree =
-    CGAL::AABB_tree<CGAL::AABB_traits<Kernel, CGAL::AABB_triangle_primitive<Kernel, Triangles::const_iterator>>>;
 
 // Target edge length at a point: graded from the size at each surface with the distance to it,
 // the distance estimated by the nearest surface vertex (cheap: Mesh_3 asks very often). Mesh_3
@@ -165,11 +159,25 @@ constexpr const char* kSelfIntersecting =
     "smoothing can touch itself at a voxel edge: smooth or remesh it)";
 }  // namespace
 
+struct ClosedSurface::Mesh {
+  SurfaceMesh surface;
+};
+
+ClosedSurface::ClosedSurface(const Points3Ref& vertices, const FacesRef& faces)
+    : mesh_(std::make_unique<Mesh>(Mesh{to_surface_mesh(vertices, faces)})) {}
+ClosedSurface::~ClosedSurface() = default;
+
 Nesting classify_nesting(const Points3Ref& source_vertices, const FacesRef& source_faces,
                          const Points3Ref& target_vertices, const FacesRef& target_faces) {
+  const ClosedSurface source(source_vertices, source_faces);
+  const ClosedSurface target(target_vertices, target_faces);
+  return classify_nesting(source, target);
+}
+
+Nesting classify_nesting(const ClosedSurface& source_surface, const ClosedSurface& target_surface) {
   try {
-    const SurfaceMesh source = to_surface_mesh(source_vertices, source_faces);
-    const SurfaceMesh target = to_surface_mesh(target_vertices, target_faces);
+    const SurfaceMesh& source = source_surface.mesh().surface;
+    const SurfaceMesh& target = target_surface.mesh().surface;
     // Mesh_3 on a self-intersecting surface may crash rather than fail.
     if (CGAL::Polygon_mesh_processing::does_self_intersect(source)) {
       throw InvalidInput(std::string("s1: ") + kSelfIntersecting);
@@ -189,11 +197,10 @@ Nesting classify_nesting(const Points3Ref& source_vertices, const FacesRef& sour
   }
 }
 
-std::vector<char> inside_surface(const Points3Ref& vertices, const FacesRef& faces, const Points3Ref& queries) {
+std::vector<char> inside_surface(const ClosedSurface& surface, const Points3Ref& queries) {
   std::vector<char> inside(static_cast<std::size_t>(queries.rows()), 0);
   try {
-    const SurfaceMesh surface = to_surface_mesh(vertices, faces);
-    const CGAL::Side_of_triangle_mesh<SurfaceMesh, Kernel> side(surface);
+    const CGAL::Side_of_triangle_mesh<SurfaceMesh, Kernel> side(surface.mesh().surface);
     for (Index i = 0; i < queries.rows(); ++i) {
       inside[static_cast<std::size_t>(i)] =
           side(Point(queries(i, 0), queries(i, 1), queries(i, 2))) != CGAL::ON_UNBOUNDED_SIDE;
@@ -204,18 +211,19 @@ std::vector<char> inside_surface(const Points3Ref& vertices, const FacesRef& fac
   return inside;
 }
 
-ShellMesh mesh_shell(const Points3Ref& source_vertices, const FacesRef& source_faces, const Points3Ref& target_vertices,
-                     const FacesRef& target_faces, bool source_inside, const ShellMeshCriteria& criteria) {
+ShellMesh mesh_shell(const ClosedSurface& source, const ClosedSurface& target, bool source_inside,
+                     const ShellMeshCriteria& criteria) {
   C3t3 c3t3;
   try {
-    std::vector<SurfaceMesh> patches{to_surface_mesh(source_vertices, source_faces),
-                                     to_surface_mesh(target_vertices, target_faces)};
+    const SurfaceMesh* patches[2] = {&source.mesh().surface, &target.mesh().surface};
     // (subdomain inside, subdomain outside) of each outward-oriented patch; the shell is 1.
     const std::pair<int, int> inner(0, 1), outer(1, 0);
     const std::pair<int, int> sides[2] = {source_inside ? inner : outer, source_inside ? outer : inner};
-    const Sizing sizing(patches[0], patches[1], criteria);
+    const Sizing sizing(*patches[0], *patches[1], criteria);
     CGAL::Random random(criteria.seed);
-    const Domain domain(patches.begin(), patches.end(), sides, sides + 2, &random);
+    // (The domain keeps copies of the patches.)
+    const Domain domain(boost::make_indirect_iterator(patches), boost::make_indirect_iterator(patches + 2), sides,
+                        sides + 2, &random);
     namespace params = CGAL::parameters;
     const Criteria mesh_criteria(params::facet_angle = 25.0, params::facet_size = sizing,
                                  params::facet_distance = criteria.facet_distance, params::cell_radius_edge_ratio = 3.0,
@@ -225,7 +233,7 @@ ShellMesh mesh_shell(const Points3Ref& source_vertices, const FacesRef& source_f
     // few vertices of each surface, as points of its patch.
     // (Asking for the construction object makes the domain detect its borders, as make_mesh_3 would.)
     (void)domain.construct_initial_points_object();
-    for (int patch = 1; patch <= 2; ++patch) seed_patch(c3t3, domain, patches[patch - 1], patch);
+    for (int patch = 1; patch <= 2; ++patch) seed_patch(c3t3, domain, *patches[patch - 1], patch);
     refine(c3t3, domain, mesh_criteria, criteria.exude);
   } catch (const CGAL::Failure_exception& e) {
     throw GeometryError(std::string("meshing the region between the surfaces failed: ") + e.what());
@@ -292,14 +300,13 @@ double signed_volume(const SurfaceMesh& mesh, const Point& o) {
 
 }  // namespace
 
-CrossingRegion::CrossingRegion(const Points3Ref& source_vertices, const FacesRef& source_faces,
-                               const Points3Ref& target_vertices, const FacesRef& target_faces)
+CrossingRegion::CrossingRegion(const ClosedSurface& source_surface, const ClosedSurface& target_surface)
     : patches_(std::make_unique<Patches>()) {
   namespace PMP = CGAL::Polygon_mesh_processing;
   Patches& p = *patches_;
   try {
-    p.source = to_surface_mesh(source_vertices, source_faces);
-    p.target = to_surface_mesh(target_vertices, target_faces);
+    p.source = source_surface.mesh().surface;
+    p.target = target_surface.mesh().surface;
     SurfaceMesh source = p.source, target = p.target;
     auto source_cut = source.add_property_map<SurfaceMesh::Edge_index, bool>("e:cut", false).first;
     auto target_cut = target.add_property_map<SurfaceMesh::Edge_index, bool>("e:cut", false).first;
@@ -383,30 +390,6 @@ ShellMesh CrossingRegion::mesh(const ShellMeshCriteria& criteria) const {
     if (patch < 1 || patch > count) return other_face;
     return p.from_source[patch - 1] ? source_face : target_face;
   });
-}
-
-TriangleHits closest_on_triangles(const Points3Ref& vertices, const FacesRef& faces, const Points3Ref& queries) {
-  Triangles triangles;
-  triangles.reserve(faces.rows());
-  auto point = [&](Index v) { return Point(vertices(v, 0), vertices(v, 1), vertices(v, 2)); };
-  for (Index f = 0; f < faces.rows(); ++f) {
-    triangles.emplace_back(point(faces(f, 0)), point(faces(f, 1)), point(faces(f, 2)));
-  }
-  TriangleHits hits;
-  hits.points.resize(queries.rows(), 3);
-  hits.faces.resize(queries.rows());
-  try {
-    SoupTree tree(triangles.cbegin(), triangles.cend());
-    tree.accelerate_distance_queries();
-    tbb::parallel_for(Index(0), Index(queries.rows()), [&](Index i) {
-      const auto [p, id] = tree.closest_point_and_primitive(Point(queries(i, 0), queries(i, 1), queries(i, 2)));
-      hits.points.row(i) << p.x(), p.y(), p.z();
-      hits.faces[i] = static_cast<Index>(id - triangles.cbegin());
-    });
-  } catch (const CGAL::Failure_exception& e) {
-    throw GeometryError(std::string("closest points on a surface failed: ") + e.what());
-  }
-  return hits;
 }
 
 }  // namespace morphomap::detail

@@ -1,7 +1,6 @@
 #pragma once
-// The region between two closed surfaces as a tetrahedral mesh (CGAL's Mesh_3), and closest
-// points on triangle sets (CGAL's AABB tree). Kept small and stable: the translation unit behind
-// it compiles for minutes.
+// The region between two closed surfaces as a tetrahedral mesh (CGAL's Mesh_3). Kept small and
+// stable: the translation unit behind it compiles for minutes.
 #include <morphomap/types.hpp>
 
 #include <memory>
@@ -9,15 +8,34 @@
 
 namespace morphomap::detail {
 
+// A surface in CGAL's form (surfaces/surface_mesh.hpp), converted once and handed to each of the
+// calls below that needs it.
+class ClosedSurface {
+ public:
+  // Throws GeometryError if the faces do not form a manifold triangle mesh.
+  ClosedSurface(const Points3Ref& vertices, const FacesRef& faces);
+  ~ClosedSurface();
+  ClosedSurface(const ClosedSurface&) = delete;
+  ClosedSurface& operator=(const ClosedSurface&) = delete;
+
+  struct Mesh;  // the CGAL surface mesh (shell_mesh.cpp)
+  const Mesh& mesh() const { return *mesh_; }
+
+ private:
+  std::unique_ptr<Mesh> mesh_;
+};
+
 // How two closed, outward-oriented surfaces lie relative to each other. Throws InvalidInput if
 // either intersects itself.
 enum class Nesting { source_inside, target_inside, disjoint, crossing };
+Nesting classify_nesting(const ClosedSurface& source, const ClosedSurface& target);
+// The same from the arrays (for a caller that has no other use for the conversion).
 Nesting classify_nesting(const Points3Ref& source_vertices, const FacesRef& source_faces,
                          const Points3Ref& target_vertices, const FacesRef& target_faces);
 
 // For each query point: whether it lies inside the closed, outward-oriented surface (exact
 // predicates, so points within rounding of the surface are still told apart); on it counts as inside.
-std::vector<char> inside_surface(const Points3Ref& vertices, const FacesRef& faces, const Points3Ref& queries);
+std::vector<char> inside_surface(const ClosedSurface& surface, const Points3Ref& queries);
 
 struct ShellMeshCriteria {
   // Target edge length: source_size + grading * (distance to the source surface) near the source,
@@ -43,8 +61,8 @@ struct ShellMesh {
 
 // Both surfaces closed, consistently oriented outwards (positive volume) and not crossing; inner
 // and outer as classify_nesting found them. Throws GeometryError if Mesh_3 fails.
-ShellMesh mesh_shell(const Points3Ref& source_vertices, const FacesRef& source_faces, const Points3Ref& target_vertices,
-                     const FacesRef& target_faces, bool source_inside, const ShellMeshCriteria& criteria);
+ShellMesh mesh_shell(const ClosedSurface& source, const ClosedSurface& target, bool source_inside,
+                     const ShellMeshCriteria& criteria);
 
 // The symmetric difference of two crossing closed surfaces: each surface cut along the curves
 // where they cross (CGAL's corefinement) into patches that lie inside or outside the other. The
@@ -53,8 +71,7 @@ class CrossingRegion {
  public:
   // Both surfaces closed, consistently oriented outwards, free of self-intersections and crossing
   // (classify_nesting). Throws InvalidInput if the two coincide over a patch.
-  CrossingRegion(const Points3Ref& source_vertices, const FacesRef& source_faces, const Points3Ref& target_vertices,
-                 const FacesRef& target_faces);
+  CrossingRegion(const ClosedSurface& source, const ClosedSurface& target);
   ~CrossingRegion();
   CrossingRegion(const CrossingRegion&) = delete;
   CrossingRegion& operator=(const CrossingRegion&) = delete;
@@ -68,13 +85,5 @@ class CrossingRegion {
   struct Patches;
   std::unique_ptr<Patches> patches_;
 };
-
-struct TriangleHits {
-  Points3 points;     // closest point on the triangles
-  IndexVector faces;  // the triangle it lies on
-};
-
-// Closest point on a set of triangles (any soup, at least one triangle) to each query, in parallel.
-TriangleHits closest_on_triangles(const Points3Ref& vertices, const FacesRef& faces, const Points3Ref& queries);
 
 }  // namespace morphomap::detail

@@ -17,6 +17,8 @@
 #include "curves/arc_curve.hpp"
 #include "curves/contact.hpp"
 #include "curves/inside.hpp"
+#include "curves/unchecked.hpp"
+#include "diffusion/laplace_unchecked.hpp"
 
 #include <unsupported/Eigen/FFT>
 
@@ -32,6 +34,9 @@
 namespace morphomap {
 
 using detail::kNaN;
+// After map_curves' entry checks, its curves and the pieces cut from them (finite, enough points)
+// go to the unchecked variants; the query points are points of those curves.
+using Unchecked = detail::CurveIndexUnchecked;
 
 std::string method_name(Method method) {
   switch (method) {
@@ -98,7 +103,9 @@ struct Job {
 };
 
 const CurveIndex& target_index(const Job& job) {
-  if (!job.target_index) job.target_index = std::make_shared<const CurveIndex>(job.target, job.target_closed);
+  if (!job.target_index) {
+    job.target_index = std::make_shared<const CurveIndex>(Unchecked::build(job.target, job.target_closed));
+  }
   return *job.target_index;
 }
 
@@ -121,6 +128,9 @@ struct Settings {
   double contact_tolerance = -1.0;  // < 0: default_contact_tolerance
   DiffusionOptions diffusion;
   double stretch_weight = kDefaultStretchWeight;  // "optimal"
+  // The curves are the ones map_curves checked to be simple (not resampled or transformed), so
+  // diffusion need not check them again.
+  bool simple_curves = false;
 };
 
 bool all_rows_equal(const Points2& points) {
@@ -139,7 +149,7 @@ void put_in_order(Points2& ends, const ArcCurve& target, const CurveIndex& targe
   const std::vector<Index> rows = detail::finite_rows(ends);
   if (rows.size() < 2) return;
   const Points2 found = ends(rows, Eigen::all);
-  const Vector arcs = target_index.closest_points(found).arc_lengths;
+  const Vector arcs = Unchecked::closest_points(target_index, found).arc_lengths;
   const double length = target.length();
   std::vector<double> unrolled(rows.size(), 0.0);
   for (std::size_t k = 1; k < rows.size(); ++k) {
@@ -209,10 +219,10 @@ double refined_anchor(const ArcCurve& source, const ArcCurve& target, double anc
 // point of the first pass is free in the second; the lower energy wins.
 Points2 optimal_ends(const Job& job, double stretch_weight) {
   if (!job.source_closed) return monotone_match(job.source, job.start_rows, job.target, stretch_weight).points;
-  const ArcCurve source(job.source, true, "c1");
-  const ArcCurve given(job.target, true, "c2");
-  const ArcCurve target(
-      relative_direction(source, given) > 0 ? given.points() : Points2(given.points().colwise().reverse()), true, "c2");
+  const ArcCurve source = ArcCurve::unchecked(job.source, true);
+  const ArcCurve given = ArcCurve::unchecked(job.target, true);
+  const ArcCurve target = ArcCurve::unchecked(
+      relative_direction(source, given) > 0 ? given.points() : Points2(given.points().colwise().reverse()), true);
   const Index n = source.size();
   const Index count = static_cast<Index>(job.start_rows.size());
   auto pass = [&](Index first, double anchor, MonotoneMatch& match) {
@@ -240,12 +250,12 @@ Points2 basic_ends(MapMethod method, const Job& job, const Points2& starts, cons
   if (starts.rows() == 0) return Points2(0, 2);
   // A piece of the target that shrank to a point (two meetings at one place) takes all starts.
   if (all_rows_equal(job.target)) return job.target.row(0).replicate(starts.rows(), 1);
-  const ArcCurve target(job.target, job.target_closed, "c2");
+  const ArcCurve target = ArcCurve::unchecked(job.target, job.target_closed);
   switch (method) {
     case MapMethod::minimal_distance:
-      return target_index(job).closest_points(starts).points;
-    case MapMethod::normal:
-      return target_index(job).line_intersections(starts, job.normals).points;
+      return Unchecked::closest_points(target_index(job), starts).points;
+    case MapMethod::normal:  // unit normals
+      return Unchecked::line_intersections(target_index(job), starts, job.normals).points;
     case MapMethod::uniform: {
       Points2 ends(starts.rows(), 2);
       for (Index i = 0; i < ends.rows(); ++i) {
@@ -255,7 +265,10 @@ Points2 basic_ends(MapMethod method, const Job& job, const Points2& starts, cons
       return ends;
     }
     case MapMethod::diffusion: {
-      const DiffusionSolution solution = solve_diffusion(job.source, job.target, job.source_closed, settings.diffusion);
+      const DiffusionSolution solution =
+          settings.simple_curves
+              ? detail::solve_diffusion_unchecked(job.source, job.target, job.source_closed, settings.diffusion)
+              : solve_diffusion(job.source, job.target, job.source_closed, settings.diffusion);
       Points2 ends(starts.rows(), 2);
       for (std::size_t j = 0; j < job.start_rows.size(); ++j) ends.row(j) = solution.ends.row(job.start_rows[j]);
       put_in_order(ends, target, target_index(job));
@@ -290,8 +303,8 @@ Method basic_method(MapMethod method) {
 // Start points per gap: the mean distance from the starts to the target over their mean spacing
 // along the source.
 double point_density(const Job& job, const Points2& starts) {
-  const double gap = target_index(job).closest_points(starts).distances.mean();
-  const double spacing = ArcCurve(job.source, job.source_closed, "c1").length() / starts.rows();
+  const double gap = Unchecked::closest_points(target_index(job), starts).distances.mean();
+  const double spacing = ArcCurve::unchecked(job.source, job.source_closed).length() / starts.rows();
   return spacing > 0.0 ? gap / spacing : 0.0;
 }
 
@@ -326,7 +339,9 @@ Vectors reverse(MapMethod method, const Job& job, const ArcCurve& whole_source, 
   }
   Vectors v;
   v.ends = start_points(back);
-  if (method == MapMethod::normal) back.normals = normals(back.source, back.source_closed)(back.start_rows, Eigen::all);
+  if (method == MapMethod::normal) {
+    back.normals = detail::normals_unchecked(back.source, back.source_closed)(back.start_rows, Eigen::all);
+  }
   v.starts = basic_ends(method, back, v.ends, settings);
   job.source_index = back.target_index, job.target_index = back.source_index;  // for the next attempt
   v.methods.assign(v.starts.rows(), reversed(basic_method(method)));
@@ -334,7 +349,7 @@ Vectors reverse(MapMethod method, const Job& job, const ArcCurve& whole_source, 
   const std::vector<Index> found = detail::finite_rows(v.starts);
   if (!found.empty()) {
     const Points2 located = v.starts(found, Eigen::all);
-    const Vector arcs = whole_source_index.closest_points(located).arc_lengths;
+    const Vector arcs = Unchecked::closest_points(whole_source_index, located).arc_lengths;
     for (std::size_t j = 0; j < found.size(); ++j) v.keys[found[j]] = whole_source.wrap(arcs[j]);
   }
   // A miss keeps its point on the target (ends), so that it can be found; its start is NaN.
@@ -406,7 +421,7 @@ double best_anchor(const ArcCurve& source, const ArcCurve& target, int direction
 
 // +1 when both closed curves turn the same way.
 int relative_direction(const ArcCurve& source, const ArcCurve& target) {
-  return orientation(source.points()) == orientation(target.points()) ? 1 : -1;
+  return detail::orientation_unchecked(source.points()) == detail::orientation_unchecked(target.points()) ? 1 : -1;
 }
 
 // Stacks the vectors of all jobs in the order of their keys (arc position of the start along the
@@ -453,18 +468,21 @@ struct Split {
   std::vector<char> on_stretch;
 };
 
-Split split_pair(const ArcCurve& source, const ArcCurve& target, bool closed, bool split, bool find_crossings,
-                 double contact_tolerance, int direction) {
+Split split_pair(const ArcCurve& source, const ArcCurve& target, const CurveIndex& source_index,
+                 const CurveIndex& target_index, bool closed, bool split, bool find_crossings, double contact_tolerance,
+                 int direction) {
   Split out;
   const Index n = source.size();
   out.on_stretch.assign(n, 0);
-  if (split || find_crossings) out.crossings = curve_intersections(source.points(), target.points(), closed);
+  if (split || find_crossings) {
+    out.crossings = detail::curve_intersections_unchecked(source.points(), target.points(), closed);
+  }
   // Where the curves meet: the crossings (when splitting) and, always, the stretches where they
   // touch or run together, which no region between them spans.
   const double tolerance =
       contact_tolerance >= 0.0 ? contact_tolerance : detail::default_contact_tolerance(source, target);
-  const std::vector<Meeting> found =
-      detail::find_meetings(source, target, split ? out.crossings : CurveIntersections(), tolerance);
+  const std::vector<Meeting> found = detail::find_meetings(source, target, source_index, target_index,
+                                                           split ? out.crossings : CurveIntersections(), tolerance);
   bool in_order = true;
   std::vector<Meeting> meetings = detail::meetings_in_order(found, target, direction, &in_order);
   const bool contact = std::any_of(found.begin(), found.end(), [](const Meeting& m) { return !m.crossing; });
@@ -559,17 +577,17 @@ std::pair<Points2, Points2> piece_polylines(const ArcCurve& source, const ArcCur
 
 Vectors map_directed(const Points2& source_points, const Points2& target_points, MapMethod method, bool closed,
                      bool split, const std::optional<std::pair<Vec2, Vec2>>& anchors, const Settings& settings) {
-  const ArcCurve source(source_points, closed, "c1");
-  const ArcCurve target(target_points, closed, "c2");
-  const auto whole_source_index = std::make_shared<const CurveIndex>(source.points(), closed);
-  const auto whole_target_index = std::make_shared<const CurveIndex>(target.points(), closed);
+  const ArcCurve source = ArcCurve::unchecked(source_points, closed);
+  const ArcCurve target = ArcCurve::unchecked(target_points, closed);
+  const auto whole_source_index = std::make_shared<const CurveIndex>(Unchecked::build(source.points(), closed));
+  const auto whole_target_index = std::make_shared<const CurveIndex>(Unchecked::build(target.points(), closed));
   const Index n = source.size();
   const bool wants_normals = method == MapMethod::normal || method == MapMethod::automatic;
-  const Points2 source_normals = wants_normals ? normals(source.points(), closed) : Points2();
+  const Points2 source_normals = wants_normals ? detail::normals_unchecked(source.points(), closed) : Points2();
   const int direction = closed ? relative_direction(source, target) : 1;
 
-  const Split pieces_of = split_pair(source, target, closed, split, closed && method == MapMethod::uniform,
-                                     settings.contact_tolerance, direction);
+  const Split pieces_of = split_pair(source, target, *whole_source_index, *whole_target_index, closed, split,
+                                     closed && method == MapMethod::uniform, settings.contact_tolerance, direction);
   const CurveIntersections& crossings = pieces_of.crossings;
   const Index k = crossings.points.rows();
   const std::vector<Meeting>& meetings = pieces_of.meetings;
@@ -602,8 +620,8 @@ Vectors map_directed(const Points2& source_points, const Points2& target_points,
         from = crossings.arc_lengths1[0];
         job.anchor = crossings.arc_lengths2[0];
       } else if (anchors) {
-        from = closest_points(anchors->first.transpose(), source.points(), true).arc_lengths[0];
-        job.anchor = closest_points(anchors->second.transpose(), target.points(), true).arc_lengths[0];
+        from = Unchecked::closest_points(*whole_source_index, anchors->first.transpose()).arc_lengths[0];
+        job.anchor = Unchecked::closest_points(*whole_target_index, anchors->second.transpose()).arc_lengths[0];
       } else {
         job.anchor = best_anchor(source, target, direction);
       }
@@ -634,7 +652,7 @@ Vectors map_directed(const Points2& source_points, const Points2& target_points,
   }
   if (!stretch_rows.empty()) {
     const Points2 queries = source.points()(stretch_rows, Eigen::all);
-    const Points2 closest = whole_target_index->closest_points(queries).points;
+    const Points2 closest = Unchecked::closest_points(*whole_target_index, queries).points;
     for (std::size_t j = 0; j < stretch_rows.size(); ++j) {
       fixed_starts.push_back(queries.row(j).transpose()), fixed_ends.push_back(closest.row(j).transpose());
       fixed.keys.push_back(source.arc(stretch_rows[j])), fixed_methods.push_back(Method::minimal_distance);
@@ -675,7 +693,7 @@ void project_onto(Points2& points, const Points2Ref& curve, bool closed) {
   const std::vector<Index> rows = detail::finite_rows(points);
   if (rows.empty()) return;
   const Points2 queries = points(rows, Eigen::all);
-  const Points2 on_curve = CurveIndex(curve, closed).closest_points(queries).points;
+  const Points2 on_curve = Unchecked::closest_points(Unchecked::build(curve, closed), queries).points;
   for (std::size_t j = 0; j < rows.size(); ++j) points.row(rows[j]) = on_curve.row(j);
 }
 
@@ -710,10 +728,10 @@ DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2, const 
   // (Each curve's point farthest from the other decides: a touching point would not.)
   auto farthest = [](const Points2Ref& points, const Points2Ref& curve) -> Vec2 {
     Index at = 0;
-    CurveIndex(curve, true).closest_points(points).distances.maxCoeff(&at);
+    Unchecked::closest_points(Unchecked::build(curve, true), points).distances.maxCoeff(&at);
     return points.row(at).transpose();
   };
-  if (closed && curve_intersections(c1.topRows(n1), c2.topRows(n2), true).points.rows() == 0 &&
+  if (closed && detail::curve_intersections_unchecked(c1.topRows(n1), c2.topRows(n2), true).points.rows() == 0 &&
       !detail::inside(farthest(c1.topRows(n1), c2.topRows(n2)), c2.topRows(n2)) &&
       !detail::inside(farthest(c2.topRows(n2), c1.topRows(n1)), c1.topRows(n1))) {
     detail::invalid("c2",
@@ -727,6 +745,13 @@ DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2, const 
   if (options.transform) {
     similarity = align_curves(a, b, closed);
     a = similarity.apply(a);
+  }
+  // Resampled or moved curves are new curves: checked once here as the core's functions check
+  // theirs (the given ones passed require_simple_curve above).
+  const bool derived = options.n > 0 || options.transform;
+  if (derived) {
+    detail::require_curve(a, closed, "c1");
+    detail::require_curve(b, closed, "c2");
   }
   std::optional<std::pair<Vec2, Vec2>> anchors;
   if (options.anchor) {
@@ -742,6 +767,7 @@ DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2, const 
   settings.contact_tolerance = options.contact_tolerance;
   settings.diffusion = options.diffusion;
   settings.stretch_weight = options.stretch_weight;
+  settings.simple_curves = !derived;
   Vectors v = options.reverse ? map_directed(b, a, options.method, closed, options.split, anchors, settings)
                               : map_directed(a, b, options.method, closed, options.split, anchors, settings);
   DisplacementField2 field;
@@ -767,10 +793,12 @@ CurveSplit split_curves(const Points2Ref& c1, const Points2Ref& c2, bool closed,
   if (std::isnan(contact_tolerance) || std::isinf(contact_tolerance)) {
     detail::invalid("contact_tolerance", "must be a finite length >= 0, or negative for the default");
   }
-  const ArcCurve source(c1.topRows(n1), closed, "c1");
-  const ArcCurve target(c2.topRows(n2), closed, "c2");
+  const ArcCurve source = ArcCurve::unchecked(c1.topRows(n1), closed);
+  const ArcCurve target = ArcCurve::unchecked(c2.topRows(n2), closed);
   const int direction = closed ? relative_direction(source, target) : 1;
-  const Split found = split_pair(source, target, closed, split, false, contact_tolerance, direction);
+  const Split found =
+      split_pair(source, target, Unchecked::build(source.points(), closed), Unchecked::build(target.points(), closed),
+                 closed, split, false, contact_tolerance, direction);
   CurveSplit out;
   out.c1 = source.points(), out.c2 = target.points();
   out.closed = closed;

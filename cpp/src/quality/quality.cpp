@@ -5,6 +5,7 @@
 #include "common/numbers.hpp"
 #include "common/validation.hpp"
 #include "curves/arc_curve.hpp"
+#include "curves/unchecked.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -41,7 +42,9 @@ Located locate(const Points2& points, const std::vector<Index>& rows, const ArcC
                const char* which, const char* curve_name, Index total) {
   Points2 queries(static_cast<Index>(rows.size()), 2);
   for (std::size_t k = 0; k < rows.size(); ++k) queries.row(k) = points.row(rows[k]);
-  const CurveHits hits = CurveIndex(raw, curve.closed()).closest_points(queries);
+  // raw passed ArcCurve's checks at quality's entry; the rows are the field's finite ones.
+  const CurveHits hits =
+      detail::CurveIndexUnchecked::closest_points(detail::CurveIndexUnchecked::build(raw, curve.closed()), queries);
 
   const double tol = kOnCurve * diagonal(curve.points());
   for (std::size_t k = 0; k < rows.size(); ++k) {
