@@ -1,5 +1,8 @@
 """Diffusion mapping against closed-form Laplace solutions."""
 
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -130,6 +133,26 @@ def test_disjoint_curves_are_refused():
         mm.solve_diffusion(circle(50), circle(50, centre=(5.0, 0.0)))
     with pytest.raises(ValueError, match="c2: lies apart from c1"):  # every method says so
         mm.map_curves(circle(50), circle(50, centre=(5.0, 0.0)), "diffusion")
+
+
+def test_a_shared_straight_stretch_is_refused_in_a_child_process():
+    # Crossing curves sharing the stretch y = 2, -1 <= x <= 0 crashed the 2D mesher (or refined
+    # forever): run where a crash fails the test rather than pytest.
+    code = """
+import numpy as np, morphomap as mm
+pairs = [([[-3, 0], [-3, -3], [0, 2], [-3, 2]], [[-1, -1], [2, -1], [2, 2], [-1, 2]]),
+         ([[-3, 0], [-3, -3], [-2, -3], [0, 2], [-3, 2]], [[-1, 1], [0, 1], [0, 2], [-1, 2]])]
+for c1, c2 in pairs:
+    try:
+        mm.solve_diffusion(np.array(c1, float), np.array(c2, float), mesh_fraction=0.1)
+    except mm.GeometryError as error:
+        print(error)
+"""
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    assert lines == ["the curves run along each other from (-1, 2) to (0, 2): the region between them has no width "
+                     "there (map_curves splits such pairs where they touch)"] * 2
 
 
 def test_bad_mesh_size():

@@ -98,12 +98,31 @@ void bad_options_are_named() {
   CHECK_THROWS(solve_diffusion(c1, apart), InvalidInput);
 }
 
+// Crossing curves that share a straight stretch (along y = 2 from x = -1 to 0) bound no area
+// there; the mesher was handed both as constraints and crashed or refined forever. Refused now,
+// with the split points of long edges (mesh_fraction 0.1) that made them nearly collinear.
+void shared_stretch_is_refused() {
+  Points2 quad(4, 2), square(4, 2), pentagon(5, 2), small(4, 2);
+  quad << -3, 0, -3, -3, 0, 2, -3, 2;
+  square << -1, -1, 2, -1, 2, 2, -1, 2;
+  pentagon << -3, 0, -3, -3, -2, -3, 0, 2, -3, 2;
+  small << -1, 1, 0, 1, 0, 2, -1, 2;
+  DiffusionOptions options;
+  options.mesh_fraction = 0.1;
+  CHECK_THROWS(solve_diffusion(quad, square, true, options), morphomap::GeometryError);
+  CHECK_THROWS(solve_diffusion(pentagon, small, true, options), morphomap::GeometryError);
+  // A hair's breadth apart they are an ordinary crossing pair.
+  square.col(1).array() += 1e-3;
+  CHECK(solve_diffusion(quad, square, true, options).vertices.rows() > 0);
+}
+
 }  // namespace
 
 int main() {
   concentric_circles();
   confocal_ellipses();
   error_falls_under_refinement();
+  shared_stretch_is_refused();
   bad_options_are_named();
   TEST_MAIN_END();
 }

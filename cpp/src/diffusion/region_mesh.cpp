@@ -2,6 +2,7 @@
 #include "diffusion/region_mesh.hpp"
 
 #include "common/interrupt_check.hpp"
+#include "common/segment_pairs.hpp"
 #include "curves/unchecked.hpp"
 
 #include <morphomap/curve_queries.hpp>
@@ -22,6 +23,7 @@
 #include <cstdint>
 #include <limits>
 #include <queue>
+#include <sstream>
 #include <string>
 #include <unordered_map>
 
@@ -250,9 +252,49 @@ std::vector<Point> layer_points(const Cdt& cdt, const std::vector<Points2>& loop
   return clear_of_loops(indexes, xy, away);
 }
 
+// Edges of the loops that run along each other (collinear, sharing more than a point) bound no
+// area there, and the constrained triangulation cannot take them: the points splitting long edges
+// are rounded off the shared line, which leaves nearly collinear constraints whose crossings CGAL
+// computes inexactly (a segfault and an endless refinement were found). Refused, the place named.
+void require_no_shared_stretch(const std::vector<Points2>& loops) {
+  std::vector<std::pair<detail::Point, detail::Point>> edges;
+  std::vector<SegmentBox> boxes;
+  for (const Points2& loop : loops) {
+    for (Index i = 0; i < loop.rows(); ++i) {
+      const detail::Point a = point_at(loop, i), b = point_at(loop, (i + 1) % loop.rows());
+      if (a == b) continue;
+      boxes.emplace_back(a, b, edges.size());
+      edges.emplace_back(a, b);
+    }
+  }
+  const auto run_together = [&](Index i, Index j) {
+    const auto& [a, b] = edges[i];
+    const auto& [c, d] = edges[j];
+    if (orient(a, b, c) != 0 || orient(a, b, d) != 0) return false;
+    // Collinear: they share more than a point where their extents along the line overlap.
+    const bool along_x = a.x() != b.x();
+    const double lo1 = along_x ? std::min(a.x(), b.x()) : std::min(a.y(), b.y());
+    const double hi1 = along_x ? std::max(a.x(), b.x()) : std::max(a.y(), b.y());
+    const double lo2 = along_x ? std::min(c.x(), d.x()) : std::min(c.y(), d.y());
+    const double hi2 = along_x ? std::max(c.x(), d.x()) : std::max(c.y(), d.y());
+    return std::min(hi1, hi2) > std::max(lo1, lo2);
+  };
+  IndexPairs shared;
+  if (test_overlapping_pairs(std::move(boxes), run_together, &shared) == 0) return;
+  const auto& [i, j] = shared.front();
+  const auto& [a, b] = edges[i];
+  const auto& [c, d] = edges[j];
+  const auto from = std::max(std::min(a, b), std::min(c, d)), to = std::min(std::max(a, b), std::max(c, d));
+  std::ostringstream where;  // six significant digits, whatever the scale
+  where << "the curves run along each other from (" << from.x() << ", " << from.y() << ") to (" << to.x() << ", "
+        << to.y() << "): the region between them has no width there (map_curves splits such pairs where they touch)";
+  throw GeometryError(where.str());
+}
+
 }  // namespace
 
 RegionMesh mesh_region(const std::vector<Points2>& loops, double max_edge) {
+  require_no_shared_stretch(loops);
   Cdt cdt;
   std::vector<Point> points;
   for (const Points2& loop : loops) {
