@@ -210,3 +210,18 @@ def test_progress_bar_only_when_asked(capfd):
     mm.map_series(frames, "normal", progress=False)
     mm.map_series(frames, "normal")  # stderr is not a terminal here
     assert "map_series" not in capfd.readouterr().err
+
+
+def test_one_bar_for_a_surface_series(capsys, monkeypatch):
+    # On a terminal after the delay (here none) the series shows its bar; its pairs' own stage
+    # bars stay off so that the two never fight over the line.
+    import sys
+
+    from morphomap import _progress
+
+    monkeypatch.setattr(_progress, "DELAY", 0.0)
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
+    sphere = trimesh.creation.icosphere(1)
+    mm.map_series([sphere.copy().apply_scale(r) for r in (1.0, 1.5)], "diffusion", reseed=None)
+    err = capsys.readouterr().err
+    assert "map_series" in err and "map_surfaces" not in err, err

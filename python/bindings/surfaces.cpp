@@ -74,11 +74,18 @@ void bind_surfaces(py::module_& m) {
   m.def(
       "map_surfaces",
       [](const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2, const std::string& method,
-         bool reverse, double mesh_size) {
+         bool reverse, double mesh_size, const py::object& on_stage) {
         SurfaceMappingOptions options;
         options.method = surface_method(method);
         options.reverse = reverse;
         options.diffusion_mesh_size = mesh_size;
+        if (!on_stage.is_none()) {
+          // The core calls it on this thread with the GIL released: taken back for the call only.
+          options.on_stage = [&on_stage](const char* stage) {
+            py::gil_scoped_acquire acquire;
+            on_stage(stage);
+          };
+        }
         DisplacementField3 field;
         InterruptGuard interruptible;
         {
@@ -88,7 +95,7 @@ void bind_surfaces(py::module_& m) {
         return field_record(std::move(field));
       },
       py::arg("v1"), py::arg("f1"), py::arg("v2"), py::arg("f2"), py::arg("method"), py::arg("reverse"),
-      py::arg("mesh_size"));
+      py::arg("mesh_size"), py::arg("on_stage") = py::none());
 
   m.def(
       "surface_quality",

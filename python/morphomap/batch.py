@@ -8,8 +8,9 @@ finish. Outputs are written atomically, so a rerun skips the jobs whose output e
 from __future__ import annotations
 
 import os
-import sys
 from dataclasses import dataclass
+
+from ._progress import as_progress, progress_over
 
 
 @dataclass
@@ -59,11 +60,14 @@ def map_batch(jobs, client=None, *, workers=None, progress=None, task=None) -> l
     ``client``: a ``distributed.Client`` (e.g. ``Client("tcp://scheduler:8786")`` for a cluster);
     by default a local cluster of ``workers`` processes (one thread each) is started and closed.
     A task is not retried on another worker when its worker dies: the job is reported failed.
+    ``progress``: a bar counting the jobs, by default on a terminal once the batch has run for 3
+    seconds (``True``: at once, ``False``: never).
     """
     import dask
     from distributed import Client, LocalCluster, as_completed
 
     jobs = list(jobs)
+    progress = as_progress(progress)
     results = {}
     pending = []
     for k, job in enumerate(jobs):
@@ -84,15 +88,7 @@ def map_batch(jobs, client=None, *, workers=None, progress=None, task=None) -> l
         try:
             work = run_job if task is None else task
             futures = {client.submit(work, jobs[k], pure=False, key=f"morphomap-job-{k}"): k for k in pending}
-            done = as_completed(futures)
-            if progress is not False and (progress or sys.stderr.isatty()):
-                try:
-                    from tqdm import tqdm
-
-                    done = tqdm(done, total=len(futures), desc="map_batch", unit="job")
-                except ImportError:
-                    pass
-            for future in done:
+            for future in progress_over(as_completed(futures), len(futures), progress, "map_batch", "job"):
                 k = futures[future]
                 try:
                     results[k] = JobResult(jobs[k], "done", future.result())

@@ -7,10 +7,14 @@ from typing import NamedTuple
 import numpy as np
 
 from . import _core
+from ._progress import StageBar, as_progress
 from ._validate import as_choice, as_faces, as_flag, as_points, as_real
 from .field import DisplacementField
 
 SURFACE_METHODS = ("minimal_distance", "normal", "diffusion", "auto", "best")
+# The stages the core reports (SurfaceMappingOptions::on_stage), in order, for the progress bar.
+DIFFUSION_STAGES = ("mesh", "solve", "trace")
+_STAGES = {"diffusion": DIFFUSION_STAGES, "auto": ("normal",) + DIFFUSION_STAGES}
 
 
 def as_surface(value, name: str) -> tuple[np.ndarray, np.ndarray]:
@@ -86,7 +90,7 @@ def surface_normals(vertices, faces) -> np.ndarray:
 
 
 def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None, skip_below=None,
-                 workers=None) -> DisplacementField:
+                 workers=None, progress=None) -> DisplacementField:
     """Map closed surface ``s1`` (time t) onto closed surface ``s2`` (time t + dt).
 
     Parameters
@@ -122,6 +126,13 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None, skip
         :func:`solve_diffusion_3d`.
     skip_below, workers : optional
         ``"best"`` only: see :mod:`morphomap.best`.
+    progress : bool, optional
+        ``"diffusion"`` and ``"auto"``: a progress bar (tqdm) on stderr naming the stage (auto's
+        ``normal``, then diffusion's ``mesh``, ``solve``, ``trace``; where ``"auto"`` falls back
+        to forward diffusion after reverse diffusion failed, the bar goes back to ``mesh``). By
+        default shown when stderr is a terminal and the call runs longer than 3 seconds; ``True``:
+        at once; ``False``: never. The other methods are quick and show none; ``"best"`` takes
+        only ``False`` or ``None`` (its candidates run side by side).
 
     Returns
     -------
@@ -130,9 +141,13 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None, skip
     """
     method = as_choice(method, "method", SURFACE_METHODS)
     reverse = as_flag(reverse, "reverse")
+    progress = as_progress(progress)
     if method == "best":
         from .best import map_best_surfaces
 
+        if progress:
+            raise ValueError("progress: method 'best' runs its candidates side by side and shows no bar; "
+                             "leave it None or False")
         if reverse:
             raise ValueError("reverse: method 'best' tries the reversed forms itself; leave it False")
         return map_best_surfaces(s1, s2, mesh_size=mesh_size, skip_below=skip_below, workers=workers)
@@ -140,5 +155,10 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None, skip
         raise ValueError("skip_below/workers: only for method 'best'")
     v1, f1 = as_surface(s1, "s1")
     v2, f2 = as_surface(s2, "s2")
-    record = _core.map_surfaces(v1, f1, v2, f2, method, reverse, as_real(mesh_size, "mesh_size", 0.0))
+    size = as_real(mesh_size, "mesh_size", 0.0)
+    bar = StageBar(progress, "map_surfaces", _STAGES.get(method, ()))
+    try:
+        record = _core.map_surfaces(v1, f1, v2, f2, method, reverse, size, bar.callback)
+    finally:
+        bar.close()
     return DisplacementField._from_core(record)

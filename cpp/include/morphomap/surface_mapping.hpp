@@ -5,6 +5,8 @@
 #include <morphomap/mapping.hpp>
 #include <morphomap/types.hpp>
 
+#include <functional>
+
 namespace morphomap {
 
 struct SurfaceMappingOptions {
@@ -22,6 +24,11 @@ struct SurfaceMappingOptions {
   MapMethod method = MapMethod::normal;
   bool reverse = false;              // map S2 -> S1 and flip: starts on S1, ends on S2, rows and faces of S2
   double diffusion_mesh_size = 0.0;  // ShellDiffusionOptions::mesh_size (0: automatic)
+  // Called with the name of each stage as it begins, on the calling thread (a progress report);
+  // may be empty. diffusion: "mesh", "solve", "trace" (ShellDiffusionOptions::on_stage).
+  // automatic: "normal", then, if it falls back, those three for each diffusion it tries (reverse,
+  // then forward where reverse fails: they can come twice). The other methods report nothing.
+  std::function<void(const char* stage)> on_stage;
 };
 
 // Both surfaces must pass check_closed_surface (named "s1" and "s2"). Start points are the

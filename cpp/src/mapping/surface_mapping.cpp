@@ -28,10 +28,10 @@ struct Surface {
 };
 
 // Vectors from the vertices of `source` to `target` (queried through `target_index`, built from
-// it) with one basic algorithm. Diffusion's fold repair also queries `source`: through
-// `source_index` where the caller has one, else through one built here.
+// it) with one basic algorithm; diffusion with `diffusion`'s options. Diffusion's fold repair also queries `source`:
+// through `source_index` where the caller has one, else through one built here.
 DisplacementField3 basic(MapMethod method, const Surface& source, const Surface& target,
-                         const SurfaceIndex& target_index, double mesh_size,
+                         const SurfaceIndex& target_index, const ShellDiffusionOptions& diffusion,
                          const SurfaceIndex* source_index = nullptr) {
   DisplacementField3 field;
   field.starts = source.vertices;
@@ -48,10 +48,8 @@ DisplacementField3 basic(MapMethod method, const Surface& source, const Surface&
       break;
     }
     case MapMethod::diffusion: {
-      ShellDiffusionOptions options;
-      options.mesh_size = mesh_size;
       const ShellDiffusionSolution solution = detail::solve_diffusion_3d(source.vertices, source.faces, target.vertices,
-                                                                         target.faces, options, &target_index);
+                                                                         target.faces, diffusion, &target_index);
       if (solution.ends.rows() != field.size())
         throw GeometryError("diffusion: the solver returned the wrong number of ends");
       field.ends = solution.ends;  // on the target itself (solve_diffusion_3d puts them there)
@@ -101,8 +99,9 @@ bool complete(const DisplacementField3& field) {
 // if it missed nothing, else minimal distance (which always finds a point): it answers wherever a
 // basic algorithm does.
 DisplacementField3 automatic(const Surface& source, const Surface& target, const SurfaceIndex& target_index,
-                             double mesh_size) {
-  DisplacementField3 normal = basic(MapMethod::normal, source, target, target_index, mesh_size);
+                             const ShellDiffusionOptions& diffusion) {
+  if (diffusion.on_stage) diffusion.on_stage("normal");
+  DisplacementField3 normal = basic(MapMethod::normal, source, target, target_index, diffusion);
   const SurfaceIndex source_index(source.vertices, source.faces);
   const bool missed = !complete(normal);
   if (!missed && count_folds(normal.starts, normal.ends, normal.faces, source.vertices, source.faces, source_index,
@@ -112,21 +111,22 @@ DisplacementField3 automatic(const Surface& source, const Surface& target, const
   for (const bool backwards : {true, false}) {
     try {
       DisplacementField3 field =
-          backwards ? flipped(basic(MapMethod::diffusion, target, source, source_index, mesh_size, &target_index))
-                    : basic(MapMethod::diffusion, source, target, target_index, mesh_size, &source_index);
+          backwards ? flipped(basic(MapMethod::diffusion, target, source, source_index, diffusion, &target_index))
+                    : basic(MapMethod::diffusion, source, target, target_index, diffusion, &source_index);
       if (complete(field)) return field;
     } catch (const GeometryError&) {
     } catch (const InvalidInput&) {  // surfaces whose region diffusion cannot mesh (they coincide in part, say)
     }
   }
   if (!missed) return normal;
-  return basic(MapMethod::minimal_distance, source, target, target_index, mesh_size);
+  return basic(MapMethod::minimal_distance, source, target, target_index, diffusion);
 }
 
-DisplacementField3 directed(MapMethod method, const Surface& source, const Surface& target, double mesh_size) {
+DisplacementField3 directed(MapMethod method, const Surface& source, const Surface& target,
+                            const ShellDiffusionOptions& diffusion) {
   const SurfaceIndex target_index(target.vertices, target.faces);
-  if (method == MapMethod::automatic) return automatic(source, target, target_index, mesh_size);
-  return basic(method, source, target, target_index, mesh_size);
+  if (method == MapMethod::automatic) return automatic(source, target, target_index, diffusion);
+  return basic(method, source, target, target_index, diffusion);
 }
 
 }  // namespace
@@ -149,9 +149,12 @@ DisplacementField3 map_surfaces(const Points3Ref& v1, const FacesRef& f1, const 
   if (!(options.diffusion_mesh_size >= 0) || !std::isfinite(options.diffusion_mesh_size)) {
     detail::invalid("mesh_size", "must be a finite number >= 0");
   }
+  ShellDiffusionOptions diffusion;
+  diffusion.mesh_size = options.diffusion_mesh_size;
+  diffusion.on_stage = options.on_stage;
   const Surface s1{v1, f1}, s2{v2, f2};
-  if (!options.reverse) return directed(options.method, s1, s2, options.diffusion_mesh_size);
-  return flipped(directed(options.method, s2, s1, options.diffusion_mesh_size));
+  if (!options.reverse) return directed(options.method, s1, s2, diffusion);
+  return flipped(directed(options.method, s2, s1, diffusion));
 }
 
 }  // namespace morphomap
