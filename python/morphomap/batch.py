@@ -58,7 +58,9 @@ def map_batch(jobs, client=None, *, workers=None, progress=None, task=None) -> l
     ``task``: the function each job runs in its worker (default :func:`run_job`; it gets the job
     and returns a summary line, writing ``job.output`` atomically).
     ``client``: a ``distributed.Client`` (e.g. ``Client("tcp://scheduler:8786")`` for a cluster);
-    by default a local cluster of ``workers`` processes (one thread each) is started and closed.
+    by default a local cluster of ``workers`` processes (one thread each; default: one per core,
+    at most one per job) is started and closed, each worker's core using its share of the cores
+    (one thread each when the workers fill them; a job's result does not depend on it).
     A task is not retried on another worker when its worker dies: the job is reported failed.
     ``progress``: a bar counting the jobs, by default on a terminal once the batch has run for 3
     seconds (``True``: at once, ``False``: never).
@@ -82,8 +84,11 @@ def map_batch(jobs, client=None, *, workers=None, progress=None, task=None) -> l
     own = client is None
     with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
         if own:
-            cluster = LocalCluster(n_workers=workers or min(len(pending), os.cpu_count() or 1), threads_per_worker=1,
-                                   processes=True, dashboard_address=None)
+            from ._batch_worker import ShareCores
+
+            count = workers or min(len(pending), os.cpu_count() or 1)
+            cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, dashboard_address=None,
+                                   plugins={ShareCores(max(1, (os.cpu_count() or 1) // count))})
             client = Client(cluster)
         try:
             work = run_job if task is None else task
