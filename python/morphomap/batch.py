@@ -82,7 +82,12 @@ def map_batch(jobs, client=None, *, workers=None, progress=None, task=None) -> l
     if not pending:
         return [results[k] for k in range(len(jobs))]
     own = client is None
-    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+    # A worker's statistical profiler samples its threads every 10 ms for a dashboard that our
+    # own cluster does not serve: off there.
+    settings = {"distributed.scheduler.allowed-failures": 0}
+    if own:
+        settings["distributed.worker.profile.enabled"] = False
+    with dask.config.set(settings):
         if own:
             from ._batch_worker import ShareCores
 
