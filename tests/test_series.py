@@ -225,3 +225,14 @@ def test_one_bar_for_a_surface_series(capsys, monkeypatch):
     mm.map_series([sphere.copy().apply_scale(r) for r in (1.0, 1.5)], "diffusion", reseed=None)
     err = capsys.readouterr().err
     assert "map_series" in err and "map_surfaces" not in err, err
+
+
+def test_surface_series_fields_are_the_independent_ones():
+    # map_series checks and indexes each frame once (PreparedSurface): the same fields and quality.
+    sphere = trimesh.creation.icosphere(2)
+    frames = [trimesh.Trimesh(sphere.vertices * [1.0 + 0.2 * k, 1.0 + 0.1 * k, 1.0], sphere.faces) for k in range(3)]
+    series = mm.map_series(frames, "auto", reseed=None, progress=False)
+    for k, field in enumerate(series.fields):
+        alone = mm.map_surfaces(frames[k], frames[k + 1], "auto")
+        np.testing.assert_array_equal(field.ends, alone.ends)
+        assert series.quality[k].qm == mm.quality(alone, frames[k], frames[k + 1]).qm

@@ -359,6 +359,23 @@ def test_auto_falls_back_to_reverse_diffusion_where_normals_miss(sphere):
     np.testing.assert_array_equal(field.ends[valid], v2[valid])
 
 
+def test_prepared_surfaces_give_the_same_fields_and_quality(sphere):
+    s1, s2 = mm.PreparedSurface(sphere, "frame 1"), mm.PreparedSurface(ellipsoid(3), "frame 2")
+    for method, reverse in (("normal", False), ("minimal_distance", False), ("auto", False), ("normal", True)):
+        plain = mm.map_surfaces(sphere, ellipsoid(3), method, reverse=reverse)
+        prepared = mm.map_surfaces(s1, s2, method, reverse=reverse)
+        np.testing.assert_array_equal(prepared.starts, plain.starts)
+        np.testing.assert_array_equal(prepared.ends, plain.ends)
+        np.testing.assert_array_equal(prepared.faces, plain.faces)
+        assert list(prepared.method) == list(plain.method)
+        assert mm.quality(prepared, s1, s2) == mm.quality(plain, sphere, ellipsoid(3))
+    mixed = mm.map_surfaces(s1, ellipsoid(3), "normal")  # one prepared: used as a plain surface
+    np.testing.assert_array_equal(mixed.ends, mm.map_surfaces(sphere, ellipsoid(3), "normal").ends)
+    v, f = sphere
+    with pytest.raises(ValueError, match=r"frames\[3\]: .*closed"):
+        mm.PreparedSurface((v, f[:-1]), "frames[3]")
+
+
 # ---- progress ---------------------------------------------------------------------------------
 
 

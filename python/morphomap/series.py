@@ -248,7 +248,7 @@ def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **op
     from ._validate import as_length
     from .mapping import map_curves
     from .quality import quality
-    from .surfaces import as_surface, map_surfaces
+    from .surfaces import PreparedSurface, as_surface, map_surfaces
 
     frames = list(frames)
     if len(frames) < 2:
@@ -273,9 +273,15 @@ def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **op
     stretches, accumulated, speeds, mean_speeds = [], [], [], []
     normal_distance = np.zeros(len(born))  # summed since each point's birth
     fields, table = [], []
+    # Surfaces are checked and indexed once each (frame k is the target of one pair and the
+    # source of the next): PreparedSurface, two at a time.
+    prepared = None if curves[0] else PreparedSurface(frames[0], "frames[0]")
     for k in progress_over(range(len(frames) - 1), len(frames) - 1, progress, "map_series", "pair"):
         a, b = frames[k], frames[k + 1]
         start = time.perf_counter()
+        if prepared is not None:
+            a, b = prepared, PreparedSurface(b, f"frames[{k + 1}]")
+            prepared = b
         try:
             field = (map_curves(a, b, method, **options) if curves[0]
                      else map_surfaces(a, b, method, progress=False, **options))

@@ -79,6 +79,27 @@ class SurfaceIndex:
         return SurfaceHits(**self._index.line_intersections(origins, directions))
 
 
+class PreparedSurface:
+    """A closed surface checked and indexed once, for several mappings of it (beyond the paper).
+
+    :func:`map_surfaces` and :func:`quality` take it wherever they take a surface; given two, they
+    skip their checks (closed, oriented outwards) and reuse the surfaces' Embree scenes, with the
+    same results bit for bit. :func:`map_series` prepares each frame once: frame k is the target of
+    one pair and the source of the next.
+
+    Parameters
+    ----------
+    surface : trimesh.Trimesh or (vertices (V, 3) float, faces (F, 3) int)
+        Closed with outward faces, as :func:`map_surfaces` wants (checked here; copied).
+    name : str
+        How error messages name it.
+    """
+
+    def __init__(self, surface, name: str = "surface"):
+        self.vertices, self.faces = as_surface(surface, name)
+        self._prepared = _core.PreparedSurface(self.vertices, self.faces, str(name))
+
+
 def surface_normals(vertices, faces) -> np.ndarray:
     """Unit normal at each vertex: the angle-weighted mean of the normals of its triangles.
 
@@ -95,9 +116,10 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None, skip
 
     Parameters
     ----------
-    s1, s2 : trimesh.Trimesh or (vertices (V, 3) float, faces (F, 3) int)
+    s1, s2 : trimesh.Trimesh or (vertices (V, 3) float, faces (F, 3) int) or PreparedSurface
         Closed, consistently oriented triangle surfaces: every edge used by exactly two faces in
-        opposite directions, finite coordinates, no zero-area face.
+        opposite directions, finite coordinates, no zero-area face. Two :class:`PreparedSurface`
+        skip the checks and index building they have done once.
     method : {"normal", "minimal_distance", "diffusion", "auto", "best"}
         ``"minimal_distance"``: each vertex of ``s1`` to its closest point on ``s2``.
         ``"normal"``: the line through each vertex along its angle-weighted normal, both
@@ -153,12 +175,17 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None, skip
         return map_best_surfaces(s1, s2, mesh_size=mesh_size, skip_below=skip_below, workers=workers)
     if skip_below is not None or workers is not None:
         raise ValueError("skip_below/workers: only for method 'best'")
-    v1, f1 = as_surface(s1, "s1")
-    v2, f2 = as_surface(s2, "s2")
+    prepared = isinstance(s1, PreparedSurface) and isinstance(s2, PreparedSurface)
+    if not prepared:
+        v1, f1 = as_surface(s1, "s1")
+        v2, f2 = as_surface(s2, "s2")
     size = as_real(mesh_size, "mesh_size", 0.0)
     bar = StageBar(progress, "map_surfaces", _STAGES.get(method, ()))
     try:
-        record = _core.map_surfaces(v1, f1, v2, f2, method, reverse, size, bar.callback)
+        if prepared:
+            record = _core.map_prepared_surfaces(s1._prepared, s2._prepared, method, reverse, size, bar.callback)
+        else:
+            record = _core.map_surfaces(v1, f1, v2, f2, method, reverse, size, bar.callback)
     finally:
         bar.close()
     return DisplacementField._from_core(record)

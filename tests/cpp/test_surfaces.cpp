@@ -272,6 +272,37 @@ int main() {
     CHECK(run(MapMethod::diffusion, small, wide, false).ends.allFinite());
   }
 
+  // Prepared surfaces (checked and indexed once) give the same fields and quality, bit for bit.
+  {
+    const PreparedSurface s1(sphere.vertices, sphere.faces, "frame 1"),
+        s2(ellipsoid.vertices, ellipsoid.faces, "frame 2");
+    const auto identical = [](const Points3& a, const Points3& b) {  // NaN where the other is NaN
+      return a.rows() == b.rows() && ((a.array() == b.array()) || (a.array().isNaN() && b.array().isNaN())).all();
+    };
+    for (const MapMethod method : {MapMethod::normal, MapMethod::minimal_distance, MapMethod::automatic}) {
+      for (const bool reverse : {false, true}) {
+        SurfaceMappingOptions same;
+        same.method = method;
+        same.reverse = reverse;
+        const DisplacementField3 plain =
+            map_surfaces(sphere.vertices, sphere.faces, ellipsoid.vertices, ellipsoid.faces, same);
+        const DisplacementField3 prepared = map_surfaces(s1, s2, same);
+        CHECK(identical(prepared.starts, plain.starts) && identical(prepared.ends, plain.ends));
+        CHECK(prepared.faces == plain.faces && prepared.methods == plain.methods);
+        const SurfaceQuality a = quality(plain, sphere.vertices, sphere.faces, ellipsoid.vertices, ellipsoid.faces);
+        const SurfaceQuality b = quality(prepared, s1, s2);
+        CHECK(a.qm1 == b.qm1 && a.folds == b.folds);
+      }
+    }
+    const Faces open = sphere.faces.topRows(sphere.faces.rows() - 1);
+    try {
+      const PreparedSurface bad(sphere.vertices, open, "frames[3]");
+      CHECK(false);
+    } catch (const InvalidInput& e) {
+      CHECK(std::string(e.what()).rfind("frames[3]: ", 0) == 0);
+    }
+  }
+
   options.method = MapMethod::uniform;
   CHECK_THROWS(map_surfaces(sphere.vertices, sphere.faces, ellipsoid.vertices, ellipsoid.faces, options), InvalidInput);
   TEST_MAIN_END();

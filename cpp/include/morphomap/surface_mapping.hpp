@@ -3,6 +3,7 @@
 // 3D Objects"): minimal distance, normal and diffusion mapping, reverse, and "auto".
 #include <morphomap/field.hpp>
 #include <morphomap/mapping.hpp>
+#include <morphomap/prepared_surface.hpp>
 #include <morphomap/types.hpp>
 
 #include <functional>
@@ -36,6 +37,10 @@ struct SurfaceMappingOptions {
 // faces. A vector that found nothing keeps its known point: NaN ends on forward vectors, NaN
 // starts on reverse ones (methods then name reverse_ variants).
 DisplacementField3 map_surfaces(const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2,
+                                const SurfaceMappingOptions& options = {});
+
+// The same on surfaces checked and indexed once (the same field, bit for bit).
+DisplacementField3 map_surfaces(const PreparedSurface& s1, const PreparedSurface& s2,
                                 const SurfaceMappingOptions& options = {});
 
 }  // namespace morphomap
