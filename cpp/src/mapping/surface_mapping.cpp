@@ -36,8 +36,8 @@ const SurfaceIndex& index_of(const Surface& surface, std::unique_ptr<SurfaceInde
 }
 
 // Vectors from the vertices of `source` to `target` (queried through `target_index`, built from
-// it) with one basic algorithm; diffusion with `diffusion`'s options. Diffusion's fold repair also queries `source`:
-// through `source_index` where the caller has one, else through one built here.
+// it) with one basic algorithm; diffusion with `diffusion`'s options. Diffusion's fold repair also
+// queries `source`: through `source_index` where the caller has one, else through one built here.
 DisplacementField3 basic(MapMethod method, const Surface& source, const Surface& target,
                          const SurfaceIndex& target_index, const ShellDiffusionOptions& diffusion,
                          const SurfaceIndex* source_index = nullptr) {
