@@ -49,16 +49,19 @@ def test_a_dead_worker_fails_its_job_only(frames):
     folder, paths = frames
 
     def task(job):  # pickled by value into the worker
+        from morphomap import _core
         from morphomap.batch import run_job
 
         if job.output.endswith("crash.csv"):
             os.kill(os.getpid(), signal.SIGSEGV)
-        return run_job(job)
+        return f"{run_job(job)}; threads {_core.active_threads()}"
 
     jobs = [Job(paths[0], paths[1], str(folder / "crash.csv")), Job(paths[1], paths[2], str(folder / "fine.csv"))]
     results = mm.map_batch(jobs, workers=2, progress=False, task=task)
     assert results[0].status == "failed" and "KilledWorker" in results[0].message
     assert results[1].status == "done" and np.isfinite(mm.read_field(folder / "fine.csv").ends).all()
+    # The two workers share the cores: each runs the core's threads on its half.
+    assert results[1].message.endswith(f"; threads {max(1, os.cpu_count() // 2)}"), results[1].message
 
 
 def test_progress_bar_only_when_asked(frames, capfd):

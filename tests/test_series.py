@@ -210,3 +210,29 @@ def test_progress_bar_only_when_asked(capfd):
     mm.map_series(frames, "normal", progress=False)
     mm.map_series(frames, "normal")  # stderr is not a terminal here
     assert "map_series" not in capfd.readouterr().err
+
+
+def test_one_bar_for_a_surface_series(capsys, monkeypatch):
+    # On a terminal after the delay (here none) the series shows its bar; its pairs' own stage
+    # bars stay off so that the two never fight over the line.
+    import sys
+
+    from morphomap import _progress
+
+    monkeypatch.setattr(_progress, "DELAY", 0.0)
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
+    sphere = trimesh.creation.icosphere(1)
+    mm.map_series([sphere.copy().apply_scale(r) for r in (1.0, 1.5)], "diffusion", reseed=None)
+    err = capsys.readouterr().err
+    assert "map_series" in err and "map_surfaces" not in err, err
+
+
+def test_surface_series_fields_are_the_independent_ones():
+    # map_series checks and indexes each frame once (PreparedSurface): the same fields and quality.
+    sphere = trimesh.creation.icosphere(2)
+    frames = [trimesh.Trimesh(sphere.vertices * [1.0 + 0.2 * k, 1.0 + 0.1 * k, 1.0], sphere.faces) for k in range(3)]
+    series = mm.map_series(frames, "auto", reseed=None, progress=False)
+    for k, field in enumerate(series.fields):
+        alone = mm.map_surfaces(frames[k], frames[k + 1], "auto")
+        np.testing.assert_array_equal(field.ends, alone.ends)
+        assert series.quality[k].qm == mm.quality(alone, frames[k], frames[k + 1]).qm

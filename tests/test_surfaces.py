@@ -372,6 +372,68 @@ def test_auto_falls_back_to_reverse_diffusion_where_normals_miss(sphere):
     np.testing.assert_array_equal(field.ends[valid], v2[valid])
 
 
+def test_prepared_surfaces_give_the_same_fields_and_quality(sphere):
+    s1, s2 = mm.PreparedSurface(sphere, "frame 1"), mm.PreparedSurface(ellipsoid(3), "frame 2")
+    for method, reverse in (("normal", False), ("minimal_distance", False), ("auto", False), ("normal", True)):
+        plain = mm.map_surfaces(sphere, ellipsoid(3), method, reverse=reverse)
+        prepared = mm.map_surfaces(s1, s2, method, reverse=reverse)
+        np.testing.assert_array_equal(prepared.starts, plain.starts)
+        np.testing.assert_array_equal(prepared.ends, plain.ends)
+        np.testing.assert_array_equal(prepared.faces, plain.faces)
+        assert list(prepared.method) == list(plain.method)
+        assert mm.quality(prepared, s1, s2) == mm.quality(plain, sphere, ellipsoid(3))
+    mixed = mm.map_surfaces(s1, ellipsoid(3), "normal")  # one prepared: used as a plain surface
+    np.testing.assert_array_equal(mixed.ends, mm.map_surfaces(sphere, ellipsoid(3), "normal").ends)
+    v, f = sphere
+    with pytest.raises(ValueError, match=r"frames\[3\]: .*closed"):
+        mm.PreparedSurface((v, f[:-1]), "frames[3]")
+
+
+# ---- progress ---------------------------------------------------------------------------------
+
+
+def test_progress_names_the_stages_and_changes_nothing(capsys):
+    v1, f1 = icosphere(2)
+    quiet = mm.map_surfaces((v1, f1), ellipsoid(2), "diffusion", progress=False)
+    assert capsys.readouterr().err == ""
+    shown = mm.map_surfaces((v1, f1), ellipsoid(2), "diffusion", progress=True)
+    err = capsys.readouterr().err
+    assert "map_surfaces" in err and "3/3" in err and "trace" in err, err
+    np.testing.assert_array_equal(shown.ends, quiet.ends)
+    # auto: the normal mapping, here all it needs (tests/cpp/test_surfaces.cpp follows a fallback).
+    mm.map_surfaces((v1, f1), ellipsoid(2), "auto", progress=True)
+    err = capsys.readouterr().err
+    assert "map_surfaces" in err and "4/4" in err and "normal" in err, err
+    mm.map_surfaces((v1, f1), ellipsoid(2), "auto")  # by default only on a terminal
+    assert capsys.readouterr().err == ""
+    with pytest.raises(TypeError, match="progress: expected True, False or None"):
+        mm.map_surfaces((v1, f1), ellipsoid(2), "diffusion", progress="yes")
+    with pytest.raises(ValueError, match="progress: method 'best'"):
+        mm.map_surfaces((v1, f1), ellipsoid(2), "best", progress=True)
+
+
+def test_a_raising_progress_callback_leaves_the_call_cleanly(monkeypatch):
+    from morphomap import _core
+    from morphomap._progress import StageBar
+
+    v1, f1 = icosphere(2)
+    v2, f2 = ellipsoid(2)
+
+    def stop(stage):
+        raise RuntimeError(f"stopped at {stage}")
+
+    with pytest.raises(RuntimeError, match="stopped at mesh"):
+        _core.map_surfaces(v1, f1, v2, f2, "diffusion", False, 0.0, stop)
+    closed = []
+    monkeypatch.setattr(StageBar, "_on_stage", lambda self, stage: (_ for _ in ()).throw(KeyboardInterrupt()))
+    monkeypatch.setattr(StageBar, "close", lambda self: closed.append(self.bar.n))
+    with pytest.raises(KeyboardInterrupt):
+        mm.map_surfaces((v1, f1), (v2, f2), "diffusion", progress=True)
+    assert closed == [0]
+    monkeypatch.undo()
+    assert mm.map_surfaces((v1, f1), (v2, f2), "diffusion", progress=False).valid.all()
+
+
 # ---- bad input ------------------------------------------------------------------------------
 
 

@@ -8,6 +8,10 @@
 
 #include "interrupt_guard.hpp"
 
+#include <tbb/global_control.h>
+
+#include <string>
+
 namespace py = pybind11;
 
 void bind_curves(py::module_& m);
@@ -43,6 +47,22 @@ PYBIND11_MODULE(_core, m) {
     d["threads"] = info.threads;
     return d;
   });
+  // For processes that share the cores with others (map_batch's workers): TBB, and Embree, which
+  // runs on it, use at most `threads` threads in this process from now on.
+  m.def(
+      "limit_threads",
+      [](int threads) {
+        if (threads < 1) throw morphomap::InvalidInput("threads: must be at least 1, got " + std::to_string(threads));
+        // Kept to the end of the process (not destroyed at exit, after TBB may have gone).
+        static tbb::global_control* limit = nullptr;
+        auto* next =
+            new tbb::global_control(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+        delete limit;
+        limit = next;
+      },
+      py::arg("threads"));
+  m.def("active_threads",
+        [] { return tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism); });
   bind_curves(m);
   bind_mapping(m);
   bind_transform(m);

@@ -4,6 +4,7 @@
 #include <pybind11/stl.h>
 
 #include <morphomap/errors.hpp>
+#include <morphomap/prepared_surface.hpp>
 #include <morphomap/quality.hpp>
 #include <morphomap/remesh.hpp>
 #include <morphomap/surface_mapping.hpp>
@@ -12,6 +13,9 @@
 #include "methods.hpp"
 
 #include "interrupt_guard.hpp"
+
+#include <memory>
+#include <string>
 
 namespace py = pybind11;
 using namespace pybind11::literals;  // results cross as dicts keyed by field name
@@ -62,6 +66,13 @@ void bind_surfaces(py::module_& m) {
           },
           py::arg("origins"), py::arg("directions"));
 
+  py::class_<PreparedSurface>(m, "PreparedSurface")
+      .def(py::init([](const Points3Ref& vertices, const FacesRef& faces, const std::string& name) {
+             py::gil_scoped_release release;
+             return std::make_unique<PreparedSurface>(vertices, faces, name.c_str());
+           }),
+           py::arg("vertices"), py::arg("faces"), py::arg("name"));
+
   m.def("vertex_normals", &vertex_normals, py::arg("vertices"), py::arg("faces"), Release());
   m.def(
       "check_closed_surface",
@@ -74,11 +85,18 @@ void bind_surfaces(py::module_& m) {
   m.def(
       "map_surfaces",
       [](const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2, const std::string& method,
-         bool reverse, double mesh_size) {
+         bool reverse, double mesh_size, const py::object& on_stage) {
         SurfaceMappingOptions options;
         options.method = surface_method(method);
         options.reverse = reverse;
         options.diffusion_mesh_size = mesh_size;
+        if (!on_stage.is_none()) {
+          // The core calls it on this thread with the GIL released: taken back for the call only.
+          options.on_stage = [&on_stage](const char* stage) {
+            py::gil_scoped_acquire acquire;
+            on_stage(stage);
+          };
+        }
         DisplacementField3 field;
         InterruptGuard interruptible;
         {
@@ -88,8 +106,46 @@ void bind_surfaces(py::module_& m) {
         return field_record(std::move(field));
       },
       py::arg("v1"), py::arg("f1"), py::arg("v2"), py::arg("f2"), py::arg("method"), py::arg("reverse"),
-      py::arg("mesh_size"));
+      py::arg("mesh_size"), py::arg("on_stage") = py::none());
 
+  m.def(
+      "map_prepared_surfaces",
+      [](const PreparedSurface& s1, const PreparedSurface& s2, const std::string& method, bool reverse,
+         double mesh_size, const py::object& on_stage) {
+        SurfaceMappingOptions options;
+        options.method = surface_method(method);
+        options.reverse = reverse;
+        options.diffusion_mesh_size = mesh_size;
+        if (!on_stage.is_none()) {
+          options.on_stage = [&on_stage](const char* stage) {  // as map_surfaces': the GIL for the call only
+            py::gil_scoped_acquire acquire;
+            on_stage(stage);
+          };
+        }
+        DisplacementField3 field;
+        InterruptGuard interruptible;
+        {
+          py::gil_scoped_release release;
+          field = map_surfaces(s1, s2, options);
+        }
+        return field_record(std::move(field));
+      },
+      py::arg("s1"), py::arg("s2"), py::arg("method"), py::arg("reverse"), py::arg("mesh_size"),
+      py::arg("on_stage") = py::none());
+  m.def(
+      "prepared_surface_quality",
+      [](const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, const PreparedSurface& s1,
+         const PreparedSurface& s2) {
+        SurfaceQuality q;
+        InterruptGuard interruptible;
+        {
+          py::gil_scoped_release release;
+          DisplacementField3 field{starts, ends, faces, {}};
+          q = quality(field, s1, s2);
+        }
+        return py::dict("qm1"_a = q.qm1, "qm2"_a = q.qm2, "qm"_a = q.qm, "folds"_a = q.folds);
+      },
+      py::arg("starts"), py::arg("ends"), py::arg("faces"), py::arg("s1"), py::arg("s2"));
   m.def(
       "surface_quality",
       [](const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, const Points3Ref& v1,

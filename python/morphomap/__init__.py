@@ -40,7 +40,7 @@ from .quality import CurveQuality, SurfaceQuality, quality
 from .batch import Job, map_batch
 from .series import Series, map_series
 from .queries import CurveHits, CurveIndex, closest_points, line_intersections
-from .surfaces import SurfaceHits, SurfaceIndex, map_surfaces, surface_normals
+from .surfaces import PreparedSurface, SurfaceHits, SurfaceIndex, map_surfaces, surface_normals
 from .transform import Similarity, align_curves, overlap_area
 
 __version__ = _build_info()["version"]
@@ -67,6 +67,7 @@ __all__ = [
     "Similarity",
     "SurfaceHits",
     "SurfaceIndex",
+    "PreparedSurface",
     "SurfaceQuality",
     "align_curves",
     "arc_lengths",

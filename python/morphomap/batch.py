@@ -8,8 +8,9 @@ finish. Outputs are written atomically, so a rerun skips the jobs whose output e
 from __future__ import annotations
 
 import os
-import sys
 from dataclasses import dataclass
+
+from ._progress import as_progress, progress_over
 
 
 @dataclass
@@ -57,13 +58,18 @@ def map_batch(jobs, client=None, *, workers=None, progress=None, task=None) -> l
     ``task``: the function each job runs in its worker (default :func:`run_job`; it gets the job
     and returns a summary line, writing ``job.output`` atomically).
     ``client``: a ``distributed.Client`` (e.g. ``Client("tcp://scheduler:8786")`` for a cluster);
-    by default a local cluster of ``workers`` processes (one thread each) is started and closed.
+    by default a local cluster of ``workers`` processes (one thread each; default: one per core,
+    at most one per job) is started and closed, each worker's core using its share of the cores
+    (one thread each when the workers fill them; a job's result does not depend on it).
     A task is not retried on another worker when its worker dies: the job is reported failed.
+    ``progress``: a bar counting the jobs, by default on a terminal once the batch has run for 3
+    seconds (``True``: at once, ``False``: never).
     """
     import dask
     from distributed import Client, LocalCluster, as_completed
 
     jobs = list(jobs)
+    progress = as_progress(progress)
     results = {}
     pending = []
     for k, job in enumerate(jobs):
@@ -76,23 +82,23 @@ def map_batch(jobs, client=None, *, workers=None, progress=None, task=None) -> l
     if not pending:
         return [results[k] for k in range(len(jobs))]
     own = client is None
-    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+    # A worker's statistical profiler samples its threads every 10 ms for a dashboard that our
+    # own cluster does not serve: off there.
+    settings = {"distributed.scheduler.allowed-failures": 0}
+    if own:
+        settings["distributed.worker.profile.enabled"] = False
+    with dask.config.set(settings):
         if own:
-            cluster = LocalCluster(n_workers=workers or min(len(pending), os.cpu_count() or 1), threads_per_worker=1,
-                                   processes=True, dashboard_address=None)
+            from ._batch_worker import ShareCores
+
+            count = workers or min(len(pending), os.cpu_count() or 1)
+            cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, dashboard_address=None,
+                                   plugins={ShareCores(max(1, (os.cpu_count() or 1) // count))})
             client = Client(cluster)
         try:
             work = run_job if task is None else task
             futures = {client.submit(work, jobs[k], pure=False, key=f"morphomap-job-{k}"): k for k in pending}
-            done = as_completed(futures)
-            if progress is not False and (progress or sys.stderr.isatty()):
-                try:
-                    from tqdm import tqdm
-
-                    done = tqdm(done, total=len(futures), desc="map_batch", unit="job")
-                except ImportError:
-                    pass
-            for future in done:
+            for future in progress_over(as_completed(futures), len(futures), progress, "map_batch", "job"):
                 k = futures[future]
                 try:
                     results[k] = JobResult(jobs[k], "done", future.result())

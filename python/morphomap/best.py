@@ -295,7 +295,7 @@ def map_best_surfaces(s1, s2, *, mesh_size=None, skip_below=None, workers=None):
     s1, s2 = as_surface(s1, "s1"), as_surface(s2, "s2")
 
     def job(name, method, reverse=False, transform=False):
-        return (name, lambda: map_surfaces(s1, s2, method, reverse=reverse, mesh_size=mesh_size),
+        return (name, lambda: map_surfaces(s1, s2, method, reverse=reverse, mesh_size=mesh_size, progress=False),
                 lambda field: quality(field, s1, s2))
 
     cheap = [job(*row) for row in _plan(("normal", "minimal_distance"), (False,))] + [job("auto", "auto")]

@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass
 
 import numpy as np
 
 from . import _core
+from ._progress import StageBar
 from ._validate import as_flag, as_real
-from .surfaces import as_surface
+from .surfaces import DIFFUSION_STAGES, as_surface
 
 
 @dataclass(frozen=True)
@@ -39,37 +39,6 @@ class ShellDiffusionSolution:
     touching: np.ndarray
     streamlines: list
     seconds: dict
-
-
-class _StageBar:
-    """A tqdm bar over the three stages, shown once a call has run for a few seconds (at once with
-    progress=True); nothing without tqdm, with progress=False, or (by default) off a terminal."""
-
-    STAGES = ("mesh", "solve", "trace")
-
-    def __init__(self, progress):
-        if progress is not None and not isinstance(progress, (bool, np.bool_)):
-            raise TypeError(f"progress: expected True, False or None, got {type(progress).__name__}")
-        self.bar = None
-        if progress is False or (progress is None and not sys.stderr.isatty()):
-            return
-        try:
-            from tqdm import tqdm
-        except ImportError:  # progress is a courtesy, never a requirement
-            return
-        self.bar = tqdm(total=len(self.STAGES), desc="solve_diffusion_3d", unit="stage", delay=0 if progress else 3)
-
-    def on_stage(self, stage):
-        if self.bar is None:
-            return
-        done = self.STAGES.index(stage)
-        self.bar.update(done - self.bar.n)
-        self.bar.set_postfix_str(stage)
-
-    def close(self):
-        if self.bar is not None:
-            self.bar.update(len(self.STAGES) - self.bar.n)
-            self.bar.close()
 
 
 def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False, progress=None) -> ShellDiffusionSolution:
@@ -113,9 +82,9 @@ def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False, progress=No
     v1, f1 = as_surface(s1, "s1")
     v2, f2 = as_surface(s2, "s2")
     size, keep = as_real(mesh_size, "mesh_size", 0.0), as_flag(streamlines, "streamlines")
-    bar = _StageBar(progress)
+    bar = StageBar(progress, "solve_diffusion_3d", DIFFUSION_STAGES)
     try:
-        solved = _core.solve_diffusion_3d(v1, f1, v2, f2, size, keep, bar.on_stage if bar.bar is not None else None)
+        solved = _core.solve_diffusion_3d(v1, f1, v2, f2, size, keep, bar.callback)
     finally:
         bar.close()
     return ShellDiffusionSolution(solved["vertices"], solved["tetrahedra"], solved["potential"], solved["ends"],

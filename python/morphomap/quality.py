@@ -9,7 +9,7 @@ import numpy as np
 from . import _core
 from ._validate import as_flag, as_points
 from .field import DisplacementField
-from .surfaces import as_surface
+from .surfaces import PreparedSurface, as_surface
 
 
 @dataclass(frozen=True)
@@ -46,7 +46,7 @@ def quality(field, c1, c2, *, closed=True):
         diagonal).
     c1, c2 : (N, 2) float
         The curves at time t and t + dt. 3D: the closed surfaces S1 and S2, each a
-        ``trimesh.Trimesh`` or a ``(vertices, faces)`` pair.
+        ``trimesh.Trimesh``, a ``(vertices, faces)`` pair or a :class:`PreparedSurface`.
     closed : bool
         Whether both curves are closed (2D only).
 
@@ -120,11 +120,13 @@ def quality(field, c1, c2, *, closed=True):
             raise ValueError(
                 "field: expected a 2D field, or a 3D field with faces (the connectivity of its start points)"
             )
-        v1, f1 = as_surface(c1, "s1")
-        v2, f2 = as_surface(c2, "s2")
-        found = _core.surface_quality(
-            field.starts, field.ends, np.ascontiguousarray(field.faces, dtype=np.int64), v1, f1, v2, f2
-        )
+        faces = np.ascontiguousarray(field.faces, dtype=np.int64)
+        if isinstance(c1, PreparedSurface) and isinstance(c2, PreparedSurface):
+            found = _core.prepared_surface_quality(field.starts, field.ends, faces, c1._prepared, c2._prepared)
+        else:
+            v1, f1 = as_surface(c1, "s1")
+            v2, f2 = as_surface(c2, "s2")
+            found = _core.surface_quality(field.starts, field.ends, faces, v1, f1, v2, f2)
         return SurfaceQuality(float(found["qm1"]), float(found["qm2"]), float(found["qm"]), int(found["folds"]))
     if field.dim != 2:
         raise ValueError(f"field: expected a 2D displacement field, got {field.dim}D")

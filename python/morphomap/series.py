@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import os
-import sys
 import time
 from dataclasses import dataclass, field as dataclass_field
 
 import numpy as np
 
+from ._progress import progress_over
 
 
 @dataclass
@@ -211,16 +211,6 @@ class Series:
                 f"{self.trajectories.shape[1]} points followed ({new} born after frame 0), {lost} lost)")
 
 
-def _progress(iterable, total, enabled, description):
-    if enabled is False or (enabled is None and not sys.stderr.isatty()):
-        return iterable
-    try:
-        from tqdm import tqdm
-    except ImportError:  # progress is a courtesy, never a requirement
-        return iterable
-    return tqdm(iterable, total=total, desc=description, unit="pair")
-
-
 def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **options) -> Series:
     """Map every consecutive pair of a time series and follow the points of the first frame.
 
@@ -243,7 +233,10 @@ def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **op
         points are followed from then on (their rows of ``trajectories`` are NaN before; ``born`` gives their frame).
         ``None`` follows only the points of frame 0. Default 2.
     progress : bool, optional
-        A progress bar (tqdm) on stderr; by default when stderr is a terminal.
+        One progress bar (tqdm) on stderr counting the pairs; by default shown when stderr is a
+        terminal and the call runs longer than 3 seconds, ``True``: at once, ``False``: never. The
+        pairs' own bars (:func:`map_surfaces`' ``progress``) stay off, so that two bars never
+        fight over the line.
     **options : passed to :func:`map_curves` (2D) or :func:`map_surfaces` (3D).
 
     Returns
@@ -255,7 +248,7 @@ def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **op
     from ._validate import as_length
     from .mapping import map_curves
     from .quality import quality
-    from .surfaces import as_surface, map_surfaces
+    from .surfaces import PreparedSurface, as_surface, map_surfaces
 
     frames = list(frames)
     if len(frames) < 2:
@@ -280,11 +273,18 @@ def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **op
     stretches, accumulated, speeds, mean_speeds = [], [], [], []
     normal_distance = np.zeros(len(born))  # summed since each point's birth
     fields, table = [], []
-    for k in _progress(range(len(frames) - 1), len(frames) - 1, progress, "map_series"):
+    # Surfaces are checked and indexed once each (frame k is the target of one pair and the
+    # source of the next): PreparedSurface, two at a time.
+    prepared = None if curves[0] else PreparedSurface(frames[0], "frames[0]")
+    for k in progress_over(range(len(frames) - 1), len(frames) - 1, progress, "map_series", "pair"):
         a, b = frames[k], frames[k + 1]
         start = time.perf_counter()
+        if prepared is not None:
+            a, b = prepared, PreparedSurface(b, f"frames[{k + 1}]")
+            prepared = b
         try:
-            field = map_curves(a, b, method, **options) if curves[0] else map_surfaces(a, b, method, **options)
+            field = (map_curves(a, b, method, **options) if curves[0]
+                     else map_surfaces(a, b, method, progress=False, **options))
         except ValueError as error:
             raise ValueError(f"frames[{k}] -> frames[{k + 1}]: {error}") from None
         q = quality(field, a, b, **({"closed": closed} if curves[0] else {}))

@@ -7,10 +7,14 @@ from typing import NamedTuple
 import numpy as np
 
 from . import _core
+from ._progress import StageBar, as_progress
 from ._validate import as_choice, as_faces, as_flag, as_points, as_real
 from .field import DisplacementField
 
 SURFACE_METHODS = ("minimal_distance", "normal", "diffusion", "auto", "best")
+# The stages the core reports (SurfaceMappingOptions::on_stage), in order, for the progress bar.
+DIFFUSION_STAGES = ("mesh", "solve", "trace")
+_STAGES = {"diffusion": DIFFUSION_STAGES, "auto": ("normal",) + DIFFUSION_STAGES}
 
 
 def as_surface(value, name: str) -> tuple[np.ndarray, np.ndarray]:
@@ -75,6 +79,27 @@ class SurfaceIndex:
         return SurfaceHits(**self._index.line_intersections(origins, directions))
 
 
+class PreparedSurface:
+    """A closed surface checked and indexed once, for several mappings of it (beyond the paper).
+
+    :func:`map_surfaces` and :func:`quality` take it wherever they take a surface; given two, they
+    skip their checks (closed, oriented outwards) and reuse the surfaces' Embree scenes, with the
+    same results bit for bit. :func:`map_series` prepares each frame once: frame k is the target of
+    one pair and the source of the next.
+
+    Parameters
+    ----------
+    surface : trimesh.Trimesh or (vertices (V, 3) float, faces (F, 3) int)
+        Closed with outward faces, as :func:`map_surfaces` wants (checked here; copied).
+    name : str
+        How error messages name it.
+    """
+
+    def __init__(self, surface, name: str = "surface"):
+        self.vertices, self.faces = as_surface(surface, name)
+        self._prepared = _core.PreparedSurface(self.vertices, self.faces, str(name))
+
+
 def surface_normals(vertices, faces) -> np.ndarray:
     """Unit normal at each vertex: the angle-weighted mean of the normals of its triangles.
 
@@ -86,14 +111,15 @@ def surface_normals(vertices, faces) -> np.ndarray:
 
 
 def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None, skip_below=None,
-                 workers=None) -> DisplacementField:
+                 workers=None, progress=None) -> DisplacementField:
     """Map closed surface ``s1`` (time t) onto closed surface ``s2`` (time t + dt).
 
     Parameters
     ----------
-    s1, s2 : trimesh.Trimesh or (vertices (V, 3) float, faces (F, 3) int)
+    s1, s2 : trimesh.Trimesh or (vertices (V, 3) float, faces (F, 3) int) or PreparedSurface
         Closed, consistently oriented triangle surfaces: every edge used by exactly two faces in
-        opposite directions, finite coordinates, no zero-area face.
+        opposite directions, finite coordinates, no zero-area face. Two :class:`PreparedSurface`
+        skip the checks and index building they have done once.
     method : {"normal", "minimal_distance", "diffusion", "auto", "best"}
         ``"minimal_distance"``: each vertex of ``s1`` to its closest point on ``s2``.
         ``"normal"``: the line through each vertex along its angle-weighted normal, both
@@ -122,6 +148,13 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None, skip
         :func:`solve_diffusion_3d`.
     skip_below, workers : optional
         ``"best"`` only: see :mod:`morphomap.best`.
+    progress : bool, optional
+        ``"diffusion"`` and ``"auto"``: a progress bar (tqdm) on stderr naming the stage (auto's
+        ``normal``, then diffusion's ``mesh``, ``solve``, ``trace``; where ``"auto"`` falls back
+        to forward diffusion after reverse diffusion failed, the bar goes back to ``mesh``). By
+        default shown when stderr is a terminal and the call runs longer than 3 seconds; ``True``:
+        at once; ``False``: never. The other methods are quick and show none; ``"best"`` takes
+        only ``False`` or ``None`` (its candidates run side by side).
 
     Returns
     -------
@@ -130,15 +163,29 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None, skip
     """
     method = as_choice(method, "method", SURFACE_METHODS)
     reverse = as_flag(reverse, "reverse")
+    progress = as_progress(progress)
     if method == "best":
         from .best import map_best_surfaces
 
+        if progress:
+            raise ValueError("progress: method 'best' runs its candidates side by side and shows no bar; "
+                             "leave it None or False")
         if reverse:
             raise ValueError("reverse: method 'best' tries the reversed forms itself; leave it False")
         return map_best_surfaces(s1, s2, mesh_size=mesh_size, skip_below=skip_below, workers=workers)
     if skip_below is not None or workers is not None:
         raise ValueError("skip_below/workers: only for method 'best'")
-    v1, f1 = as_surface(s1, "s1")
-    v2, f2 = as_surface(s2, "s2")
-    record = _core.map_surfaces(v1, f1, v2, f2, method, reverse, as_real(mesh_size, "mesh_size", 0.0))
+    prepared = isinstance(s1, PreparedSurface) and isinstance(s2, PreparedSurface)
+    if not prepared:
+        v1, f1 = as_surface(s1, "s1")
+        v2, f2 = as_surface(s2, "s2")
+    size = as_real(mesh_size, "mesh_size", 0.0)
+    bar = StageBar(progress, "map_surfaces", _STAGES.get(method, ()))
+    try:
+        if prepared:
+            record = _core.map_prepared_surfaces(s1._prepared, s2._prepared, method, reverse, size, bar.callback)
+        else:
+            record = _core.map_surfaces(v1, f1, v2, f2, method, reverse, size, bar.callback)
+    finally:
+        bar.close()
     return DisplacementField._from_core(record)

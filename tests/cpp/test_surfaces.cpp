@@ -8,7 +8,10 @@
 #include <limits>
 #include <map>
 #include <random>
+#include <stdexcept>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "check.hpp"
 
@@ -232,6 +235,72 @@ int main() {
     CHECK_THROWS(
         count_folds(sphere.vertices, folded, sphere.faces, sphere.vertices, sphere.faces, sphere.vertices, open),
         InvalidInput);
+  }
+
+  // The progress callback hears the stages in order: diffusion's three; auto's normal mapping,
+  // then, where normals miss (a big sphere round a small one off its centre), reverse diffusion's.
+  {
+    const Mesh small = unit_sphere(2), inner = scaled(unit_sphere(2), 0.5, 0.5, 0.5);
+    const Mesh big = scaled(unit_sphere(2), 3.0, 3.0, 3.0);
+    Mesh off = inner;
+    off.vertices.col(0).array() += 1.0;
+    const Mesh wide = scaled(small, 2.0, 1.5, 1.2);
+    std::vector<std::string> stages;
+    SurfaceMappingOptions heard;
+    heard.on_stage = [&](const char* stage) { stages.emplace_back(stage); };
+    const auto run = [&](MapMethod method, const Mesh& a, const Mesh& b, bool reverse) {
+      stages.clear();
+      heard.method = method;
+      heard.reverse = reverse;
+      return map_surfaces(a.vertices, a.faces, b.vertices, b.faces, heard);
+    };
+    run(MapMethod::diffusion, small, wide, false);
+    CHECK((stages == std::vector<std::string>{"mesh", "solve", "trace"}));
+    run(MapMethod::diffusion, small, wide, true);
+    CHECK((stages == std::vector<std::string>{"mesh", "solve", "trace"}));
+    run(MapMethod::automatic, small, wide, false);  // normals of a sphere reach an ellipsoid round it
+    CHECK((stages == std::vector<std::string>{"normal"}));
+    const DisplacementField3 fallback = run(MapMethod::automatic, big, off, false);
+    CHECK(fallback.methods.front() == Method::reverse_diffusion);
+    CHECK((stages == std::vector<std::string>{"normal", "mesh", "solve", "trace"}));
+    run(MapMethod::normal, small, wide, false);
+    CHECK(stages.empty());
+    // An exception thrown by the callback leaves the call, and the next call runs as usual.
+    heard.on_stage = [](const char*) { throw std::runtime_error("stop"); };
+    CHECK_THROWS(run(MapMethod::diffusion, small, wide, false), std::runtime_error);
+    heard.on_stage = nullptr;
+    CHECK(run(MapMethod::diffusion, small, wide, false).ends.allFinite());
+  }
+
+  // Prepared surfaces (checked and indexed once) give the same fields and quality, bit for bit.
+  {
+    const PreparedSurface s1(sphere.vertices, sphere.faces, "frame 1"),
+        s2(ellipsoid.vertices, ellipsoid.faces, "frame 2");
+    const auto identical = [](const Points3& a, const Points3& b) {  // NaN where the other is NaN
+      return a.rows() == b.rows() && ((a.array() == b.array()) || (a.array().isNaN() && b.array().isNaN())).all();
+    };
+    for (const MapMethod method : {MapMethod::normal, MapMethod::minimal_distance, MapMethod::automatic}) {
+      for (const bool reverse : {false, true}) {
+        SurfaceMappingOptions same;
+        same.method = method;
+        same.reverse = reverse;
+        const DisplacementField3 plain =
+            map_surfaces(sphere.vertices, sphere.faces, ellipsoid.vertices, ellipsoid.faces, same);
+        const DisplacementField3 prepared = map_surfaces(s1, s2, same);
+        CHECK(identical(prepared.starts, plain.starts) && identical(prepared.ends, plain.ends));
+        CHECK(prepared.faces == plain.faces && prepared.methods == plain.methods);
+        const SurfaceQuality a = quality(plain, sphere.vertices, sphere.faces, ellipsoid.vertices, ellipsoid.faces);
+        const SurfaceQuality b = quality(prepared, s1, s2);
+        CHECK(a.qm1 == b.qm1 && a.folds == b.folds);
+      }
+    }
+    const Faces open = sphere.faces.topRows(sphere.faces.rows() - 1);
+    try {
+      const PreparedSurface bad(sphere.vertices, open, "frames[3]");
+      CHECK(false);
+    } catch (const InvalidInput& e) {
+      CHECK(std::string(e.what()).rfind("frames[3]: ", 0) == 0);
+    }
   }
 
   options.method = MapMethod::uniform;

@@ -1,6 +1,7 @@
 #pragma once
 // The paper's quality measures of a 2D displacement field (section "Quantitative Evaluation").
 #include <morphomap/field.hpp>
+#include <morphomap/prepared_surface.hpp>
 #include <morphomap/surface_queries.hpp>
 #include <morphomap/types.hpp>
 
@@ -93,5 +94,7 @@ Index count_folds(const Points3Ref& starts, const Points3Ref& ends, const FacesR
 // and field.faces must index the field's rows, else InvalidInput naming "field".
 SurfaceQuality quality(const DisplacementField3& field, const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2,
                        const FacesRef& f2);
+// The same on surfaces checked and indexed once.
+SurfaceQuality quality(const DisplacementField3& field, const PreparedSurface& s1, const PreparedSurface& s2);
 
 }  // namespace morphomap

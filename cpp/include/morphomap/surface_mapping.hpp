@@ -3,7 +3,10 @@
 // 3D Objects"): minimal distance, normal and diffusion mapping, reverse, and "auto".
 #include <morphomap/field.hpp>
 #include <morphomap/mapping.hpp>
+#include <morphomap/prepared_surface.hpp>
 #include <morphomap/types.hpp>
+
+#include <functional>
 
 namespace morphomap {
 
@@ -22,6 +25,11 @@ struct SurfaceMappingOptions {
   MapMethod method = MapMethod::normal;
   bool reverse = false;              // map S2 -> S1 and flip: starts on S1, ends on S2, rows and faces of S2
   double diffusion_mesh_size = 0.0;  // ShellDiffusionOptions::mesh_size (0: automatic)
+  // Called with the name of each stage as it begins, on the calling thread (a progress report);
+  // may be empty. diffusion: "mesh", "solve", "trace" (ShellDiffusionOptions::on_stage).
+  // automatic: "normal", then, if it falls back, those three for each diffusion it tries (reverse,
+  // then forward where reverse fails: they can come twice). The other methods report nothing.
+  std::function<void(const char* stage)> on_stage;
 };
 
 // Both surfaces must pass check_closed_surface (named "s1" and "s2"). Start points are the
@@ -29,6 +37,10 @@ struct SurfaceMappingOptions {
 // faces. A vector that found nothing keeps its known point: NaN ends on forward vectors, NaN
 // starts on reverse ones (methods then name reverse_ variants).
 DisplacementField3 map_surfaces(const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2,
+                                const SurfaceMappingOptions& options = {});
+
+// The same on surfaces checked and indexed once (the same field, bit for bit).
+DisplacementField3 map_surfaces(const PreparedSurface& s1, const PreparedSurface& s2,
                                 const SurfaceMappingOptions& options = {});
 
 }  // namespace morphomap

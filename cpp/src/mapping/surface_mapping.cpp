@@ -25,13 +25,21 @@ namespace {
 struct Surface {
   Points3Ref vertices;
   FacesRef faces;
+  const SurfaceIndex* index = nullptr;  // its query index where the caller has one (PreparedSurface)
 };
 
+// `surface`'s own index, else one built into `built`.
+const SurfaceIndex& index_of(const Surface& surface, std::unique_ptr<SurfaceIndex>& built) {
+  if (surface.index != nullptr) return *surface.index;
+  built = std::make_unique<SurfaceIndex>(surface.vertices, surface.faces);
+  return *built;
+}
+
 // Vectors from the vertices of `source` to `target` (queried through `target_index`, built from
-// it) with one basic algorithm. Diffusion's fold repair also queries `source`: through
-// `source_index` where the caller has one, else through one built here.
+// it) with one basic algorithm; diffusion with `diffusion`'s options. Diffusion's fold repair also
+// queries `source`: through `source_index` where the caller has one, else through one built here.
 DisplacementField3 basic(MapMethod method, const Surface& source, const Surface& target,
-                         const SurfaceIndex& target_index, double mesh_size,
+                         const SurfaceIndex& target_index, const ShellDiffusionOptions& diffusion,
                          const SurfaceIndex* source_index = nullptr) {
   DisplacementField3 field;
   field.starts = source.vertices;
@@ -48,10 +56,8 @@ DisplacementField3 basic(MapMethod method, const Surface& source, const Surface&
       break;
     }
     case MapMethod::diffusion: {
-      ShellDiffusionOptions options;
-      options.mesh_size = mesh_size;
       const ShellDiffusionSolution solution = detail::solve_diffusion_3d(source.vertices, source.faces, target.vertices,
-                                                                         target.faces, options, &target_index);
+                                                                         target.faces, diffusion, &target_index);
       if (solution.ends.rows() != field.size())
         throw GeometryError("diffusion: the solver returned the wrong number of ends");
       field.ends = solution.ends;  // on the target itself (solve_diffusion_3d puts them there)
@@ -101,9 +107,11 @@ bool complete(const DisplacementField3& field) {
 // if it missed nothing, else minimal distance (which always finds a point): it answers wherever a
 // basic algorithm does.
 DisplacementField3 automatic(const Surface& source, const Surface& target, const SurfaceIndex& target_index,
-                             double mesh_size) {
-  DisplacementField3 normal = basic(MapMethod::normal, source, target, target_index, mesh_size);
-  const SurfaceIndex source_index(source.vertices, source.faces);
+                             const ShellDiffusionOptions& diffusion) {
+  if (diffusion.on_stage) diffusion.on_stage("normal");
+  DisplacementField3 normal = basic(MapMethod::normal, source, target, target_index, diffusion);
+  std::unique_ptr<SurfaceIndex> built;
+  const SurfaceIndex& source_index = index_of(source, built);
   const bool missed = !complete(normal);
   if (!missed && count_folds(normal.starts, normal.ends, normal.faces, source.vertices, source.faces, source_index,
                              target.vertices, target.faces, target_index) == 0) {
@@ -112,32 +120,30 @@ DisplacementField3 automatic(const Surface& source, const Surface& target, const
   for (const bool backwards : {true, false}) {
     try {
       DisplacementField3 field =
-          backwards ? flipped(basic(MapMethod::diffusion, target, source, source_index, mesh_size, &target_index))
-                    : basic(MapMethod::diffusion, source, target, target_index, mesh_size, &source_index);
+          backwards ? flipped(basic(MapMethod::diffusion, target, source, source_index, diffusion, &target_index))
+                    : basic(MapMethod::diffusion, source, target, target_index, diffusion, &source_index);
       if (complete(field)) return field;
     } catch (const GeometryError&) {
     } catch (const InvalidInput&) {  // surfaces whose region diffusion cannot mesh (they coincide in part, say)
     }
   }
   if (!missed) return normal;
-  return basic(MapMethod::minimal_distance, source, target, target_index, mesh_size);
+  return basic(MapMethod::minimal_distance, source, target, target_index, diffusion);
 }
 
-DisplacementField3 directed(MapMethod method, const Surface& source, const Surface& target, double mesh_size) {
-  const SurfaceIndex target_index(target.vertices, target.faces);
-  if (method == MapMethod::automatic) return automatic(source, target, target_index, mesh_size);
-  return basic(method, source, target, target_index, mesh_size);
+DisplacementField3 directed(MapMethod method, const Surface& source, const Surface& target,
+                            const ShellDiffusionOptions& diffusion) {
+  std::unique_ptr<SurfaceIndex> built;
+  const SurfaceIndex& target_index = index_of(target, built);
+  if (method == MapMethod::automatic) return automatic(source, target, target_index, diffusion);
+  return basic(method, source, target, target_index, diffusion, source.index);
 }
 
-}  // namespace
-
-DisplacementField3 map_surfaces(const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2,
-                                const SurfaceMappingOptions& options) {
-  detail::require_outward(check_closed_surface(v1, f1, "s1"), "s1");
-  detail::require_outward(check_closed_surface(v2, f2, "s2"), "s2");
+// map_surfaces on two checked surfaces.
+DisplacementField3 checked(const Surface& s1, const Surface& s2, const SurfaceMappingOptions& options) {
   // Both surfaces free of self-intersections (classify_nesting checks), and overlapping: frames
   // of one organ do (see map_curves).
-  if (detail::classify_nesting(v1, f1, v2, f2) == detail::Nesting::disjoint) {
+  if (detail::classify_nesting(s1.vertices, s1.faces, s2.vertices, s2.faces) == detail::Nesting::disjoint) {
     detail::invalid("s2",
                     "lies apart from s1 (the surfaces neither cross nor enclose one another): consecutive "
                     "frames of one organ overlap; check their units and offsets");
@@ -149,9 +155,26 @@ DisplacementField3 map_surfaces(const Points3Ref& v1, const FacesRef& f1, const 
   if (!(options.diffusion_mesh_size >= 0) || !std::isfinite(options.diffusion_mesh_size)) {
     detail::invalid("mesh_size", "must be a finite number >= 0");
   }
-  const Surface s1{v1, f1}, s2{v2, f2};
-  if (!options.reverse) return directed(options.method, s1, s2, options.diffusion_mesh_size);
-  return flipped(directed(options.method, s2, s1, options.diffusion_mesh_size));
+  ShellDiffusionOptions diffusion;
+  diffusion.mesh_size = options.diffusion_mesh_size;
+  diffusion.on_stage = options.on_stage;
+  if (!options.reverse) return directed(options.method, s1, s2, diffusion);
+  return flipped(directed(options.method, s2, s1, diffusion));
+}
+
+}  // namespace
+
+DisplacementField3 map_surfaces(const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2,
+                                const SurfaceMappingOptions& options) {
+  detail::require_outward(check_closed_surface(v1, f1, "s1"), "s1");
+  detail::require_outward(check_closed_surface(v2, f2, "s2"), "s2");
+  return checked(Surface{v1, f1}, Surface{v2, f2}, options);
+}
+
+DisplacementField3 map_surfaces(const PreparedSurface& s1, const PreparedSurface& s2,
+                                const SurfaceMappingOptions& options) {
+  return checked(Surface{s1.vertices(), s1.faces(), &s1.index()}, Surface{s2.vertices(), s2.faces(), &s2.index()},
+                 options);
 }
 
 }  // namespace morphomap

@@ -159,15 +159,16 @@ Index count_folds(const Points3Ref& starts, const Points3Ref& ends, const FacesR
   return count_folds(starts, ends, faces, v1, f1, SurfaceIndex(v1, f1), v2, f2, SurfaceIndex(v2, f2));
 }
 
-SurfaceQuality quality(const DisplacementField3& field, const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2,
-                       const FacesRef& f2) {
-  detail::require_outward(check_closed_surface(v1, f1, "s1"), "s1");
-  detail::require_outward(check_closed_surface(v2, f2, "s2"), "s2");
+namespace {
+
+// quality on two checked surfaces, queried through their indexes.
+SurfaceQuality checked_quality(const DisplacementField3& field, const Points3Ref& v1, const FacesRef& f1,
+                               const SurfaceIndex& index1, const Points3Ref& v2, const FacesRef& f2,
+                               const SurfaceIndex& index2) {
   if (field.ends.rows() != field.starts.rows() || field.starts.cols() != 3 || field.ends.cols() != 3) {
     detail::invalid("field", "starts and ends must both have shape (M, 3)");
   }
   require_field_faces(field.faces, field.size(), "field");
-  const SurfaceIndex index1(v1, f1), index2(v2, f2);
   require_on(field.starts, v1, index1, "start point");
   require_on(field.ends, v2, index2, "end point");
 
@@ -206,6 +207,19 @@ SurfaceQuality quality(const DisplacementField3& field, const Points3Ref& v1, co
   q.qm = q.qm1 * q.qm2;
   q.folds = count_folds(field.starts, field.ends, field.faces, v1, f1, index1, v2, f2, index2);
   return q;
+}
+
+}  // namespace
+
+SurfaceQuality quality(const DisplacementField3& field, const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2,
+                       const FacesRef& f2) {
+  detail::require_outward(check_closed_surface(v1, f1, "s1"), "s1");
+  detail::require_outward(check_closed_surface(v2, f2, "s2"), "s2");
+  return checked_quality(field, v1, f1, SurfaceIndex(v1, f1), v2, f2, SurfaceIndex(v2, f2));
+}
+
+SurfaceQuality quality(const DisplacementField3& field, const PreparedSurface& s1, const PreparedSurface& s2) {
+  return checked_quality(field, s1.vertices(), s1.faces(), s1.index(), s2.vertices(), s2.faces(), s2.index());
 }
 
 }  // namespace morphomap
