@@ -89,12 +89,12 @@ def series_table(frames, map_pair, method, label, rounds):
     return series
 
 
-def batch_table(pairs: int, workers: int, method: str):
+def batch_table(pairs: int, workers: int, method: str, subdivisions: int = 3):
     from morphomap.batch import Job, map_batch, run_job
 
     folder = tempfile.mkdtemp(prefix="bench_series_")
     try:
-        sphere = trimesh.creation.icosphere(3)  # 1,280 faces
+        sphere = trimesh.creation.icosphere(subdivisions)  # 1,280 faces at 3, 5,120 at 4
         paths = []
         for k in range(pairs):  # a sphere inside an ellipsoid, a little larger pair by pair
             for name, axes in (("inner", [1.0, 1.0, 1.0]), ("outer", [1.8, 1.6, 1.5])):
@@ -116,7 +116,8 @@ def batch_table(pairs: int, workers: int, method: str):
         failed = [r for r in results if r.status != "done"]
         difference = max((np.abs(mm.read_field(a.output).ends - mm.read_field(b.output).ends).max()
                           for a, b in zip(jobs["loop"], jobs["batch"]) if os.path.exists(b.output)), default=np.nan)
-        print(f"\n**map_batch: {pairs} 3D pairs ({method}, 1,280 faces each)**; before: {before}; after: {busy()}\n")
+        print(f"\n**map_batch: {pairs} 3D pairs ({method}, {len(sphere.faces):,} faces each)**; before: {before}; "
+              f"after: {busy()}\n")
         print("| sequential loop s | cores it used | map_batch, 2 workers s (cluster start included) | speed-up "
               "| failed | largest end difference |")
         print("|---:|---:|---:|---:|---:|---:|")
@@ -130,6 +131,8 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="4 batch pairs instead of 16")
     parser.add_argument("--method", default="auto", help="the series' method, 2D and 3D (default auto)")
     parser.add_argument("--rounds", type=int, default=5, help="series timings: best of this many runs (default 5)")
+    parser.add_argument("--batch-subdivisions", type=int, default=3,
+                        help="icosphere subdivisions of the batch pairs: 3 (1,280 faces, default) or 4 (5,120)")
     parser.add_argument("--skip", default="", help="comma-separated parts to skip: 2d, 3d, batch")
     args = parser.parse_args()
     skip = set(filter(None, args.skip.split(",")))
@@ -141,7 +144,7 @@ def main() -> None:
         series_table([budding_surface(t) for t in range(5)], mm.map_surfaces, args.method,
                      f"3D: 5 frames, 5,120 faces per surface, {args.method}", args.rounds)
     if "batch" not in skip:
-        batch_table(4 if args.quick else 16, 2, "diffusion")
+        batch_table(4 if args.quick else 16, 2, "diffusion", args.batch_subdivisions)
 
 
 if __name__ == "__main__":
