@@ -1,5 +1,6 @@
 """Diffusion mapping against closed-form Laplace solutions."""
 
+import os
 import subprocess
 import sys
 
@@ -153,6 +154,43 @@ for c1, c2 in pairs:
     lines = done.stdout.splitlines()
     assert lines == ["the curves run along each other from (-1, 2) to (0, 2): the region between them has no width "
                      "there (map_curves splits such pairs where they touch)"] * 2
+
+
+def _rectangle(x0, y0, x1, y1, n):
+    """n points per side, counter-clockwise from (x0, y0)."""
+    t = np.linspace(0.0, 1.0, n, endpoint=False)
+    return np.vstack([np.column_stack([x0 + (x1 - x0) * t, np.full(n, y0)]),
+                      np.column_stack([np.full(n, x1), y0 + (y1 - y0) * t]),
+                      np.column_stack([x1 - (x1 - x0) * t, np.full(n, y1)]),
+                      np.column_stack([np.full(n, x0), y1 - (y1 - y0) * t])])
+
+
+@pytest.mark.parametrize("outer", [(0.0, 0.0, 2.0, 1.5), (-1.0, 0.0, 2.0, 2.0)])
+def test_nested_rectangles_sharing_sides_map_without_crossings(outer):
+    # Contact splitting leaves a piece's loop running along the other curve for up to a sample
+    # spacing (a slit of no width): the mesher takes it, unsplit, and the fields stay crossing-free.
+    c1, c2 = _rectangle(0.0, 0.0, 1.0, 1.0, 8), _rectangle(*outer, 8)
+    for method in ("diffusion", "auto"):
+        field = mm.map_curves(c1, c2, method, reverse=True)
+        assert mm.quality(field, c1, c2).crossings == 0, method
+        assert np.isfinite(field.starts).all() and np.isfinite(field.ends).all()
+
+
+def test_pieces_meeting_at_a_rounded_crossing_in_a_child_process():
+    # The aligned curves' pieces met at a crossing computed on each curve, 1e-16 apart: the loop
+    # joining them had an edge of that length and the mesher crashed (transformed diffusion, and
+    # so "best").
+    code = """
+import numpy as np, morphomap as mm
+from test_diffusion import _rectangle
+c1, c2 = _rectangle(0, 0, 1, 1, 5), _rectangle(0.5, -0.5, 1.5, 1, 7)
+mm.map_curves(c1, c2, "diffusion", transform=True)
+print(mm.quality(mm.map_curves(c1, c2, "best"), c1, c2).crossings)
+"""
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
+                          cwd=os.path.dirname(__file__))
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["0"]
 
 
 def test_bad_mesh_size():

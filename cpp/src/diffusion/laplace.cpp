@@ -376,6 +376,7 @@ DiffusionSolution solve(const Points2Ref& source_points, const Points2Ref& targe
   // Boundary loops; input points are numbered source first, then target.
   std::vector<Points2> loops;
   bool crossing = false;
+  bool same_start = false, same_end = false;  // open curves: they share an end point
   if (closed) {
     crossing = detail::curve_intersections_unchecked(source, target, true).points.rows() > 0;
     if (!crossing && !detail::inside(source.row(0).transpose(), target) &&
@@ -384,9 +385,14 @@ DiffusionSolution solve(const Points2Ref& source_points, const Points2Ref& targe
     }
     loops = {source, target};
   } else {
-    // source forwards, then target backwards; shared end points (crossings) appear once.
-    const bool same_start = source.row(0) == target.row(0);
-    const bool same_end = source.row(ns - 1) == target.row(nt - 1);
+    // source forwards, then target backwards; shared end points (crossings) appear once. Ends within
+    // rounding of each other are one point: the joining edge of 1e-16 they would leave crashed
+    // the 2D mesher.
+    const double extent = (source.colwise().maxCoeff() - source.colwise().minCoeff()).norm() +
+                          (target.colwise().maxCoeff() - target.colwise().minCoeff()).norm();
+    const double rounding = 1e-12 * extent;
+    same_start = (source.row(0) - target.row(0)).norm() <= rounding;
+    same_end = (source.row(ns - 1) - target.row(nt - 1)).norm() <= rounding;
     const Index t_begin = same_start ? 1 : 0, t_end = same_end ? nt - 1 : nt;
     Points2 loop(ns + (t_end - t_begin), 2);
     loop.topRows(ns) = source;
@@ -437,9 +443,7 @@ DiffusionSolution solve(const Points2Ref& source_points, const Points2Ref& targe
     const Index input = mesh.input[v];
     if (input >= 0) {
       kind[v] = input < ns ? source_vertex : target_vertex;
-      if (!closed && input < ns &&
-          ((input == 0 && source.row(0) == target.row(0)) ||
-           (input == ns - 1 && source.row(ns - 1) == target.row(nt - 1)))) {
+      if (!closed && input < ns && ((input == 0 && same_start) || (input == ns - 1 && same_end))) {
         kind[v] = target_vertex;  // a shared end point: already on the target
       }
     } else if (mesh.on_boundary[v]) {

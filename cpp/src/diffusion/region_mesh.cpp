@@ -252,19 +252,26 @@ std::vector<Point> layer_points(const Cdt& cdt, const std::vector<Points2>& loop
   return clear_of_loops(indexes, xy, away);
 }
 
-// Edges of the loops that run along each other (collinear, sharing more than a point) bound no
-// area there, and the constrained triangulation cannot take them: the points splitting long edges
-// are rounded off the shared line, which leaves nearly collinear constraints whose crossings CGAL
-// computes inexactly (a segfault and an endless refinement were found). Refused, the place named.
-void require_no_shared_stretch(const std::vector<Points2>& loops) {
+// Which edges of a loop run along another of its edges (collinear, sharing more than a point; per
+// loop, edge i from point i to the next): a piece's loop may, along a stretch where the curves
+// touch. Edges of two loops that do are refused. Such edges must not be split beforehand: the split
+// points are rounded off the shared line, and CGAL computes the crossings of the nearly collinear
+// constraints that leaves inexactly (a segfault and an endless refinement were found). Unsplit,
+// each edge's end points lie exactly on the other and the exact predicates join them.
+std::vector<std::vector<char>> edges_running_together(const std::vector<Points2>& loops) {
+  std::vector<std::vector<char>> flags(loops.size());
   std::vector<std::pair<detail::Point, detail::Point>> edges;
+  std::vector<std::pair<std::size_t, Index>> owner;  // (loop, edge) of each
   std::vector<SegmentBox> boxes;
-  for (const Points2& loop : loops) {
+  for (std::size_t l = 0; l < loops.size(); ++l) {
+    const Points2& loop = loops[l];
+    flags[l].assign(loop.rows(), 0);
     for (Index i = 0; i < loop.rows(); ++i) {
       const detail::Point a = point_at(loop, i), b = point_at(loop, (i + 1) % loop.rows());
       if (a == b) continue;
       boxes.emplace_back(a, b, edges.size());
       edges.emplace_back(a, b);
+      owner.emplace_back(l, i);
     }
   }
   const auto run_together = [&](Index i, Index j) {
@@ -280,21 +287,29 @@ void require_no_shared_stretch(const std::vector<Points2>& loops) {
     return std::min(hi1, hi2) > std::max(lo1, lo2);
   };
   IndexPairs shared;
-  if (test_overlapping_pairs(std::move(boxes), run_together, &shared) == 0) return;
-  const auto& [i, j] = shared.front();
-  const auto& [a, b] = edges[i];
-  const auto& [c, d] = edges[j];
-  const auto from = std::max(std::min(a, b), std::min(c, d)), to = std::min(std::max(a, b), std::max(c, d));
-  std::ostringstream where;  // six significant digits, whatever the scale
-  where << "the curves run along each other from (" << from.x() << ", " << from.y() << ") to (" << to.x() << ", "
-        << to.y() << "): the region between them has no width there (map_curves splits such pairs where they touch)";
-  throw GeometryError(where.str());
+  test_overlapping_pairs(std::move(boxes), run_together, &shared);
+  for (const auto& [i, j] : shared) {
+    if (owner[i].first != owner[j].first) {
+      // Two closed curves (two loops) that run together: even unsplit, their crossing constraints
+      // crashed CGAL, and the odd-nesting rule cannot tell the sides of a stretch bounded twice.
+      const auto& [a, b] = edges[i];
+      const auto& [c, d] = edges[j];
+      const auto from = std::max(std::min(a, b), std::min(c, d)), to = std::min(std::max(a, b), std::max(c, d));
+      std::ostringstream where;  // six significant digits, whatever the scale
+      where << "the curves run along each other from (" << from.x() << ", " << from.y() << ") to (" << to.x() << ", "
+            << to.y()
+            << "): the region between them has no width there (map_curves splits such pairs where they touch)";
+      throw GeometryError(where.str());
+    }
+    for (const Index e : {i, j}) flags[owner[e].first][owner[e].second] = 1;
+  }
+  return flags;
 }
 
 }  // namespace
 
 RegionMesh mesh_region(const std::vector<Points2>& loops, double max_edge) {
-  require_no_shared_stretch(loops);
+  const std::vector<std::vector<char>> unsplit = edges_running_together(loops);
   Cdt cdt;
   std::vector<Point> points;
   for (const Points2& loop : loops) {
@@ -327,7 +342,8 @@ RegionMesh mesh_region(const std::vector<Points2>& loops, double max_edge) {
       if (!(pieces <= static_cast<double>(kMaxVertices))) too_many_vertices();
     }
     Index first = 0;
-    for (const Points2& loop : loops) {
+    for (std::size_t l = 0; l < loops.size(); ++l) {
+      const Points2& loop = loops[l];
       const Index n = loop.rows();
       for (Index i = 0; i < n; ++i) {
         if (i % 4096 == 0) check_interrupt();
@@ -335,7 +351,7 @@ RegionMesh mesh_region(const std::vector<Points2>& loops, double max_edge) {
         if (a == b) continue;
         // Edges longer than the mesh size are split evenly beforehand, as the mesher would.
         const double length = std::sqrt(CGAL::squared_distance(a->point(), b->point()));
-        const int pieces = max_edge > 0 ? static_cast<int>(std::ceil(length / max_edge)) : 1;
+        const int pieces = max_edge > 0 && !unsplit[l][i] ? static_cast<int>(std::ceil(length / max_edge)) : 1;
         auto previous = a;
         for (int k = 1; k < pieces; ++k) {
           const double t = static_cast<double>(k) / pieces;

@@ -499,11 +499,16 @@ Split split_pair(const ArcCurve& source, const ArcCurve& target, const CurveInde
   // their start to the first and from the last to their end) and maps onto the target between
   // the same two meetings.
   const Index count = static_cast<Index>(meetings.size());
+  // A crossing is one point on both curves: the same bits in both pieces (computed on each curve it
+  // can differ in the last bit, and the loop that joins the pieces then has an edge of 1e-16 that
+  // the 2D mesher crashed on).
   auto begin_of = [&](const Meeting& m, double shift) {
-    return End{m.source_begin + shift, m.target_begin, m.source_point_begin, m.target_point_begin, true};
+    return End{m.source_begin + shift, m.target_begin, m.source_point_begin,
+               m.crossing ? m.source_point_begin : m.target_point_begin, true};
   };
   auto end_of = [&](const Meeting& m) {
-    return End{m.source_end, m.target_end, m.source_point_end, m.target_point_end, true};
+    return End{m.source_end, m.target_end, m.source_point_end, m.crossing ? m.source_point_end : m.target_point_end,
+               true};
   };
   if (closed) {
     for (Index p = 0; p < count; ++p) {
