@@ -18,6 +18,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 namespace morphomap {
 namespace {
@@ -114,14 +115,22 @@ double signed_measure(const Points3& x, const Tetrahedra& cells, Index c) {
 template <class Interior>
 void measure_inversions(Interior& out) {
   const auto moved = (out.points + out.displacement).eval();
-  out.inverted = 0;
-  out.min_jacobian = std::numeric_limits<double>::infinity();
-  for (Index c = 0; c < out.cells.rows(); ++c) {
-    const double before = signed_measure(out.points, out.cells, c);
-    const double ratio = before != 0 ? signed_measure(moved, out.cells, c) / before : 0.0;
-    if (!(ratio > 0)) ++out.inverted;
-    out.min_jacobian = std::min(out.min_jacobian, ratio);
-  }
+  // In parallel: a count and a smallest ratio (NaN never kept) do not depend on the order.
+  using Tally = std::pair<Index, double>;
+  const Tally tally = tbb::parallel_reduce(
+      tbb::blocked_range<Index>(0, out.cells.rows(), 4096), Tally(0, std::numeric_limits<double>::infinity()),
+      [&](const tbb::blocked_range<Index>& range, Tally sum) {
+        for (Index c = range.begin(); c < range.end(); ++c) {
+          const double before = signed_measure(out.points, out.cells, c);
+          const double ratio = before != 0 ? signed_measure(moved, out.cells, c) / before : 0.0;
+          if (!(ratio > 0)) ++sum.first;
+          sum.second = std::min(sum.second, ratio);
+        }
+        return sum;
+      },
+      [](const Tally& a, const Tally& b) { return Tally(a.first + b.first, std::min(a.second, b.second)); });
+  out.inverted = tally.first;
+  out.min_jacobian = tally.second;
 }
 
 // The field's displacement at the mesh's boundary nodes (`fixed`; zero elsewhere until solved),
@@ -233,10 +242,18 @@ Eigen::MatrixXd extension_step(const Points& x, const Cells& cells, const std::v
 template <int D, class Interior>
 void solve_motion(Interior& out, const std::vector<char>& fixed, const ExtendOptions& options) {
   // A flat cell has no gradients: its stiffness would be infinite.
-  for (Index c = 0; c < out.cells.rows(); ++c) {
-    if (!(std::abs(signed_measure(out.points, out.cells, c)) > 0)) {
-      detail::invalid("mesh", "cell " + std::to_string(c) + " is flat (zero " + (D == 2 ? "area" : "volume") + ")");
-    }
+  const Index cell_count = out.cells.rows();
+  const Index flat = tbb::parallel_reduce(
+      tbb::blocked_range<Index>(0, cell_count, 4096), cell_count,
+      [&](const tbb::blocked_range<Index>& range, Index first_flat) {
+        for (Index c = range.begin(); c < range.end() && c < first_flat; ++c) {
+          if (!(std::abs(signed_measure(out.points, out.cells, c)) > 0)) first_flat = c;
+        }
+        return first_flat;
+      },
+      [](Index a, Index b) { return std::min(a, b); });
+  if (flat < cell_count) {
+    detail::invalid("mesh", "cell " + std::to_string(flat) + " is flat (zero " + (D == 2 ? "area" : "volume") + ")");
   }
   const Eigen::MatrixXd boundary = out.displacement;
   Eigen::MatrixXd total = Eigen::MatrixXd::Zero(out.points.rows(), D);
