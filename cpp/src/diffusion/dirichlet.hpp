@@ -7,6 +7,7 @@
 
 #include "common/interrupt_check.hpp"
 #include "diffusion/block_cg.hpp"
+#include "diffusion/free_assembly.hpp"
 #include "diffusion/multifrontal.hpp"
 #include "diffusion/nested_dissection.hpp"
 
@@ -117,27 +118,9 @@ Eigen::MatrixXd solve_dirichlet_values(Index vertex_count, const Elements& eleme
     if (!fixed[v]) unknown[v] = free_count++;
   }
   if (free_count == 0) return values;
-  const int corners = static_cast<int>(elements.cols());
-  std::vector<Eigen::Triplet<double>> entries;
-  entries.reserve(corners * corners * elements.rows());
-  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(free_count, values.cols());
-  for (Index e = 0; e < elements.rows(); ++e) {
-    const auto k = local(e);
-    for (int i = 0; i < corners; ++i) {
-      const Index vi = elements(e, i);
-      if (unknown[vi] < 0) continue;
-      for (int j = 0; j < corners; ++j) {
-        const Index vj = elements(e, j);
-        if (unknown[vj] >= 0) {
-          entries.emplace_back(unknown[vi], unknown[vj], k(i, j));
-        } else {
-          rhs.row(unknown[vi]) -= k(i, j) * values.row(vj);
-        }
-      }
-    }
-  }
-  Eigen::SparseMatrix<double> stiffness(free_count, free_count);
-  stiffness.setFromTriplets(entries.begin(), entries.end());
+  Eigen::SparseMatrix<double> stiffness;
+  Eigen::MatrixXd rhs;
+  assemble_free(elements, local, unknown, free_count, values, stiffness, rhs);
   Eigen::MatrixXd x(free_count, values.cols());
   bool solved = false;
   if (iterative) {

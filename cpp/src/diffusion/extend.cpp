@@ -13,38 +13,74 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 namespace morphomap {
 namespace {
 
-// The nodes on the mesh's boundary: the corners of the cell faces (edges in 2D, triangles in
-// 3D) that only one cell has.
+// The nodes on the mesh's boundary: the corners of the cell sides (edges in 2D, triangles in
+// 3D) that only one cell has. Each side is filed under its smallest corner (a counting sort) as
+// one number naming its other corners, so that a side is only compared with the few filed under
+// the same node, in parallel by node.
 template <class Cells>
 std::vector<char> boundary_nodes(const Cells& cells, Index node_count) {
   constexpr int corners = Cells::ColsAtCompileTime;
   using Side = std::array<Index, corners - 1>;
-  std::vector<Side> sides;
-  sides.reserve(cells.rows() * corners);
-  for (Index c = 0; c < cells.rows(); ++c) {
-    for (int skip = 0; skip < corners; ++skip) {
-      Side side;
-      for (int i = 0, k = 0; i < corners; ++i) {
-        if (i != skip) side[k++] = cells(c, i);
+  const Index side_count = cells.rows() * corners;
+  const auto side_of = [&](Index s) {
+    const Index c = s / corners;
+    const int skip = static_cast<int>(s % corners);
+    Side side;
+    for (int i = 0, k = 0; i < corners; ++i) {
+      if (i != skip) side[k++] = cells(c, i);
+    }
+    std::sort(side.begin(), side.end());
+    return side;
+  };
+  // The corners after the smallest, as one number (node_count^2 fits: node indices are far below 2^31).
+  const auto others = [&](const Side& side) {
+    Index key = 0;
+    for (int k = 1; k < corners - 1; ++k) key = key * node_count + side[k];
+    return key;
+  };
+  std::vector<Index> smallest(side_count), key(side_count);
+  tbb::parallel_for(tbb::blocked_range<Index>(0, side_count, 4096), [&](const tbb::blocked_range<Index>& range) {
+    for (Index s = range.begin(); s < range.end(); ++s) {
+      const Side side = side_of(s);
+      smallest[s] = side[0];
+      key[s] = others(side);
+    }
+  });
+  std::vector<Index> first(node_count + 1, 0);  // sides filed under node v: first[v] .. first[v + 1]
+  for (Index s = 0; s < side_count; ++s) ++first[smallest[s] + 1];
+  for (Index v = 0; v < node_count; ++v) first[v + 1] += first[v];
+  std::vector<Index> filed(side_count), next(first.begin(), first.end() - 1);
+  for (Index s = 0; s < side_count; ++s) filed[next[smallest[s]]++] = key[s];
+  // Per node, its sides sorted; a side met twice is inside (both copies set to -1), the rest are on the boundary.
+  tbb::parallel_for(tbb::blocked_range<Index>(0, node_count, 1024), [&](const tbb::blocked_range<Index>& range) {
+    for (Index v = range.begin(); v < range.end(); ++v) {
+      const auto begin = filed.begin() + first[v], end = filed.begin() + first[v + 1];
+      std::sort(begin, end);
+      for (auto k = begin; k != end;) {
+        auto run = k + 1;
+        while (run != end && *run == *k) ++run;
+        if (run - k > 1) std::fill(k, run, Index(-1));
+        k = run;
       }
-      std::sort(side.begin(), side.end());
-      sides.push_back(side);
     }
-  }
-  std::sort(sides.begin(), sides.end());
+  });
   std::vector<char> on_boundary(node_count, 0);
-  for (std::size_t k = 0; k < sides.size();) {
-    std::size_t end = k + 1;
-    while (end < sides.size() && sides[end] == sides[k]) ++end;
-    if (end - k == 1) {
-      for (const Index v : sides[k]) on_boundary[v] = 1;
+  for (Index v = 0; v < node_count; ++v) {
+    for (Index k = first[v]; k < first[v + 1]; ++k) {
+      if (filed[k] < 0) continue;
+      on_boundary[v] = 1;
+      for (Index key = filed[k], i = 1; i < corners - 1; ++i, key /= node_count) on_boundary[key % node_count] = 1;
     }
-    k = end;
   }
   return on_boundary;
 }
@@ -79,14 +115,22 @@ double signed_measure(const Points3& x, const Tetrahedra& cells, Index c) {
 template <class Interior>
 void measure_inversions(Interior& out) {
   const auto moved = (out.points + out.displacement).eval();
-  out.inverted = 0;
-  out.min_jacobian = std::numeric_limits<double>::infinity();
-  for (Index c = 0; c < out.cells.rows(); ++c) {
-    const double before = signed_measure(out.points, out.cells, c);
-    const double ratio = before != 0 ? signed_measure(moved, out.cells, c) / before : 0.0;
-    if (!(ratio > 0)) ++out.inverted;
-    out.min_jacobian = std::min(out.min_jacobian, ratio);
-  }
+  // In parallel: a count and a smallest ratio (NaN never kept) do not depend on the order.
+  using Tally = std::pair<Index, double>;
+  const Tally tally = tbb::parallel_reduce(
+      tbb::blocked_range<Index>(0, out.cells.rows(), 4096), Tally(0, std::numeric_limits<double>::infinity()),
+      [&](const tbb::blocked_range<Index>& range, Tally sum) {
+        for (Index c = range.begin(); c < range.end(); ++c) {
+          const double before = signed_measure(out.points, out.cells, c);
+          const double ratio = before != 0 ? signed_measure(moved, out.cells, c) / before : 0.0;
+          if (!(ratio > 0)) ++sum.first;
+          sum.second = std::min(sum.second, ratio);
+        }
+        return sum;
+      },
+      [](const Tally& a, const Tally& b) { return Tally(a.first + b.first, std::min(a.second, b.second)); });
+  out.inverted = tally.first;
+  out.min_jacobian = tally.second;
 }
 
 // The field's displacement at the mesh's boundary nodes (`fixed`; zero elsewhere until solved),
@@ -198,10 +242,18 @@ Eigen::MatrixXd extension_step(const Points& x, const Cells& cells, const std::v
 template <int D, class Interior>
 void solve_motion(Interior& out, const std::vector<char>& fixed, const ExtendOptions& options) {
   // A flat cell has no gradients: its stiffness would be infinite.
-  for (Index c = 0; c < out.cells.rows(); ++c) {
-    if (!(std::abs(signed_measure(out.points, out.cells, c)) > 0)) {
-      detail::invalid("mesh", "cell " + std::to_string(c) + " is flat (zero " + (D == 2 ? "area" : "volume") + ")");
-    }
+  const Index cell_count = out.cells.rows();
+  const Index flat = tbb::parallel_reduce(
+      tbb::blocked_range<Index>(0, cell_count, 4096), cell_count,
+      [&](const tbb::blocked_range<Index>& range, Index first_flat) {
+        for (Index c = range.begin(); c < range.end() && c < first_flat; ++c) {
+          if (!(std::abs(signed_measure(out.points, out.cells, c)) > 0)) first_flat = c;
+        }
+        return first_flat;
+      },
+      [](Index a, Index b) { return std::min(a, b); });
+  if (flat < cell_count) {
+    detail::invalid("mesh", "cell " + std::to_string(flat) + " is flat (zero " + (D == 2 ? "area" : "volume") + ")");
   }
   const Eigen::MatrixXd boundary = out.displacement;
   Eigen::MatrixXd total = Eigen::MatrixXd::Zero(out.points.rows(), D);
