@@ -96,7 +96,10 @@ class PreparedSurface:
     """
 
     def __init__(self, surface, name: str = "surface"):
-        self.vertices, self.faces = as_surface(surface, name)
+        # Copies, read-only: the core holds its own, and a caller editing the mesh afterwards must not
+        # leave the two sides of a mixed call on different surfaces.
+        self.vertices, self.faces = (np.array(array, copy=True) for array in as_surface(surface, name))
+        self.vertices.flags.writeable = self.faces.flags.writeable = False
         self._prepared = _core.PreparedSurface(self.vertices, self.faces, str(name))
 
 
