@@ -3,6 +3,7 @@
 // midpoint lies inside the region, on random vectors between two wavy pieces (a polygon) and
 // between two nested wavy closed curves (the ring cut along an anchor); regions that are not simple
 // polygons are named.
+#include "curves/inside.hpp"
 #include "mapping/match_region.hpp"
 
 #include "check.hpp"
@@ -29,19 +30,11 @@ bool meet(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
   return d1 * d2 <= 0.0 && d3 * d4 <= 0.0;
 }
 
-// Even-odd rule over the closed polylines `loops`.
+// Even-odd rule over the closed polylines `loops`: inside an odd number of them (the project's
+// one-polygon test, not the code under test).
 bool inside(const Vec2& p, const std::vector<Points2>& loops) {
   bool in = false;
-  for (const Points2& loop : loops) {
-    const Index n = loop.rows();
-    for (Index i = 0, j = n - 1; i < n; j = i++) {
-      const double yi = loop(i, 1), yj = loop(j, 1);
-      if ((yi > p.y()) != (yj > p.y())) {
-        const double x = loop(j, 0) + (p.y() - yj) * (loop(i, 0) - loop(j, 0)) / (yi - yj);
-        if (p.x() < x) in = !in;
-      }
-    }
-  }
+  for (const Points2& loop : loops) in ^= morphomap::detail::inside(p, loop);
   return in;
 }
 
