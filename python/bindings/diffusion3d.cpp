@@ -7,6 +7,7 @@
 #include <morphomap/laplace3d.hpp>
 
 #include "interrupt_guard.hpp"
+#include "stage_callback.hpp"
 
 #include <algorithm>
 
@@ -21,13 +22,7 @@ void bind_diffusion3d(py::module_& m) {
         ShellDiffusionOptions options;
         options.mesh_size = mesh_size;
         options.keep_streamlines = keep_streamlines;
-        if (!on_stage.is_none()) {
-          // The core calls it on this thread with the GIL released: taken back for the call only.
-          options.on_stage = [&on_stage](const char* stage) {
-            py::gil_scoped_acquire acquire;
-            on_stage(stage);
-          };
-        }
+        options.on_stage = stage_callback(on_stage);
         ShellDiffusionSolution solution;
         InterruptGuard interruptible;
         {

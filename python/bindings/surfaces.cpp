@@ -13,6 +13,7 @@
 #include "methods.hpp"
 
 #include "interrupt_guard.hpp"
+#include "stage_callback.hpp"
 
 #include <memory>
 #include <string>
@@ -90,13 +91,7 @@ void bind_surfaces(py::module_& m) {
         options.method = surface_method(method);
         options.reverse = reverse;
         options.diffusion_mesh_size = mesh_size;
-        if (!on_stage.is_none()) {
-          // The core calls it on this thread with the GIL released: taken back for the call only.
-          options.on_stage = [&on_stage](const char* stage) {
-            py::gil_scoped_acquire acquire;
-            on_stage(stage);
-          };
-        }
+        options.on_stage = stage_callback(on_stage);
         DisplacementField3 field;
         InterruptGuard interruptible;
         {
@@ -116,12 +111,7 @@ void bind_surfaces(py::module_& m) {
         options.method = surface_method(method);
         options.reverse = reverse;
         options.diffusion_mesh_size = mesh_size;
-        if (!on_stage.is_none()) {
-          options.on_stage = [&on_stage](const char* stage) {  // as map_surfaces': the GIL for the call only
-            py::gil_scoped_acquire acquire;
-            on_stage(stage);
-          };
-        }
+        options.on_stage = stage_callback(on_stage);
         DisplacementField3 field;
         InterruptGuard interruptible;
         {
