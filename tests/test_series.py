@@ -1,5 +1,7 @@
 """Time series: chained fields and trajectories against closed forms."""
 
+import re
+
 import numpy as np
 import pytest
 import trimesh
@@ -236,3 +238,84 @@ def test_surface_series_fields_are_the_independent_ones():
         alone = mm.map_surfaces(frames[k], frames[k + 1], "auto")
         np.testing.assert_array_equal(field.ends, alone.ends)
         assert series.quality[k].qm == mm.quality(alone, frames[k], frames[k + 1]).qm
+
+
+def assert_same_quality(a, b):
+    # Bit for bit, NaN where the other is NaN.
+    for name in ("qm1", "qm2", "qm", "crossings"):
+        x, y = getattr(a, name), getattr(b, name)
+        assert x == y or (np.isnan(x) and np.isnan(y)), (name, x, y)
+
+
+def test_curve_series_fields_are_the_independent_ones():
+    # map_series checks and indexes each 2D frame once (PreparedCurve): the same fields and quality
+    # as map_curves and quality on each pair.
+    frames = [circle(150)] + [budding(0.8 * t, 400) for t in range(1, 4)]
+    for method in ("auto", "normal", "diffusion"):
+        series = mm.map_series(frames, method, reseed=None, progress=False)
+        for k, field in enumerate(series.fields):
+            alone = mm.map_curves(frames[k], frames[k + 1], method)
+            np.testing.assert_array_equal(field.starts, alone.starts)
+            np.testing.assert_array_equal(field.ends, alone.ends)
+            assert list(field.method) == list(alone.method)
+            q, plain = series.quality[k], mm.quality(alone, frames[k], frames[k + 1])
+            assert (q.qm1, q.qm2, q.qm, q.defects) == (plain.qm1, plain.qm2, plain.qm, plain.crossings)
+
+
+@pytest.mark.parametrize("closed", [True, False])
+def test_prepared_curves_give_the_same_fields_and_quality(closed):
+    c1 = budding(0.0, 300)
+    c2 = budding(1.5, 340) * [1.0, 1.2]  # crosses c1: split into pieces
+    if closed:
+        c1 = np.vstack([c1, c1[:1]])  # a closing repeat of the first point, kept as given
+    else:
+        c1, c2 = c1[:150], c2[:170]
+    p1, p2 = mm.PreparedCurve(c1, "frame 1", closed=closed), mm.PreparedCurve(c2, "frame 2", closed=closed)
+    np.testing.assert_array_equal(p1.points, c1)
+    assert not p1.points.flags.writeable and p1.closed is closed
+    for method in ("auto", "normal", "minimal_distance", "uniform", "diffusion", "optimal"):
+        for options in ({}, {"reverse": True}, {"n": 200}, {"transform": True}):
+            try:
+                plain = mm.map_curves(c1, c2, method, closed=closed, **options)
+            except (ValueError, mm.GeometryError) as refused:  # then refused alike
+                with pytest.raises(type(refused), match=re.escape(str(refused))):
+                    mm.map_curves(p1, p2, method, closed=closed, **options)
+                continue
+            prepared = mm.map_curves(p1, p2, method, closed=closed, **options)
+            np.testing.assert_array_equal(prepared.starts, plain.starts)
+            np.testing.assert_array_equal(prepared.ends, plain.ends)
+            assert list(prepared.method) == list(plain.method)
+            np.testing.assert_array_equal(prepared.source, plain.source)
+            assert_same_quality(mm.quality(prepared, p1, p2, closed=closed),
+                                mm.quality(plain, c1, c2, closed=closed))
+    mixed = mm.map_curves(p1, c2, "normal", closed=closed)  # one prepared: used as its points
+    np.testing.assert_array_equal(mixed.ends, mm.map_curves(c1, c2, "normal", closed=closed).ends)
+    assert_same_quality(mm.quality(mixed, p1, c2, closed=closed), mm.quality(mixed, c1, c2, closed=closed))
+
+
+def test_prepared_curves_refuse_what_they_are_not():
+    curve, sphere = circle(100), trimesh.creation.icosphere(1)
+    with pytest.raises(ValueError, match=r"frames\[3\]: expected shape \(N, 2\)"):  # wrong dimension
+        mm.PreparedCurve(sphere.vertices, "frames[3]")
+    with pytest.raises(ValueError, match=r"frames\[3\]: the curve intersects itself"):
+        mm.PreparedCurve([[0, 0], [1, 1], [1, 0], [0, 1]], "frames[3]")
+    with pytest.raises(TypeError, match="closed"):
+        mm.PreparedCurve(curve, closed="yes")
+    prepared, open_one = mm.PreparedCurve(curve), mm.PreparedCurve(curve[:50], closed=False)
+    with pytest.raises(ValueError, match="c2: was prepared as an open curve"):
+        mm.map_curves(prepared, open_one)
+    with pytest.raises(ValueError, match="c1: was prepared as a closed curve"):
+        mm.map_curves(prepared, open_one, closed=False)
+    field = mm.map_curves(prepared, prepared, "normal")
+    with pytest.raises(ValueError, match="c1: was prepared as a closed curve"):
+        mm.quality(field, prepared, prepared, closed=False)
+    # A prepared curve where a surface is expected, and a prepared surface where a curve is.
+    with pytest.raises(TypeError, match="s1"):
+        mm.map_surfaces(prepared, sphere)
+    surface_field = mm.map_surfaces(sphere, sphere.copy().apply_scale(1.5), "normal")
+    with pytest.raises(TypeError, match="s1"):
+        mm.quality(surface_field, prepared, mm.PreparedCurve(2 * curve))
+    with pytest.raises(TypeError, match="c1"):
+        mm.map_curves(mm.PreparedSurface(sphere), prepared)
+    with pytest.raises(TypeError, match="c2"):
+        mm.quality(field, prepared, mm.PreparedSurface(sphere))

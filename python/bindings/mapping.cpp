@@ -1,4 +1,5 @@
-// Bindings of the 2D mapping: map_curves with its options, and the diffusion solution.
+// Bindings of the 2D mapping: map_curves with its options (on plain or prepared curves), and the
+// diffusion solution.
 #include <pybind11/eigen.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -6,10 +7,14 @@
 #include <morphomap/errors.hpp>
 #include <morphomap/laplace.hpp>
 #include <morphomap/mapping.hpp>
+#include <morphomap/prepared_curve.hpp>
 
 #include "methods.hpp"
 
 #include "interrupt_guard.hpp"
+
+#include <memory>
+#include <string>
 
 namespace py = pybind11;
 using namespace morphomap;
@@ -47,12 +52,12 @@ CurveMappingOptions curve_mapping_options(const std::string& method, bool closed
   return options;
 }
 
-}  // namespace
-
-void bind_mapping(py::module_& m) {
+// map_curves on plain (Points2Ref) or prepared curves, bound under `name` with the same options.
+template <class Curve>
+void def_map_curves(py::module_& m, const char* name) {
   m.def(
-      "map_curves",
-      [](const Points2Ref& c1, const Points2Ref& c2, const std::string& method, bool closed, Index n, bool reverse,
+      name,
+      [](const Curve& c1, const Curve& c2, const std::string& method, bool closed, Index n, bool reverse,
          bool transform, bool split, std::optional<Vec2> anchor, double density_threshold, double contact_tolerance,
          double mesh_size, double mesh_fraction, double stretch_weight) {
         const CurveMappingOptions options =
@@ -70,6 +75,19 @@ void bind_mapping(py::module_& m) {
       py::arg("transform"), py::arg("split"), py::arg("anchor"), py::arg("density_threshold"),
       py::arg("contact_tolerance"), py::arg("mesh_size"), py::arg("mesh_fraction"),
       py::arg("stretch_weight") = kDefaultStretchWeight);
+}
+
+}  // namespace
+
+void bind_mapping(py::module_& m) {
+  py::class_<PreparedCurve>(m, "PreparedCurve")
+      .def(py::init([](const Points2Ref& points, bool closed, const std::string& name) {
+             py::gil_scoped_release release;
+             return std::make_unique<PreparedCurve>(points, closed, name.c_str());
+           }),
+           py::arg("points"), py::arg("closed"), py::arg("name"));
+  def_map_curves<Points2Ref>(m, "map_curves");
+  def_map_curves<PreparedCurve>(m, "map_prepared_curves");
   // map_curves' checks of its options alone (method "best" makes them before running candidates).
   m.def(
       "validate_options",

@@ -34,7 +34,7 @@ from .io import (
     write_interior,
     write_surface,
 )
-from .mapping import map_curves
+from .mapping import PreparedCurve, map_curves
 from .plot import plot_field, plot_field_3d
 from .quality import CurveQuality, SurfaceQuality, quality
 from .batch import Job, map_batch
@@ -67,6 +67,7 @@ __all__ = [
     "Similarity",
     "SurfaceHits",
     "SurfaceIndex",
+    "PreparedCurve",
     "PreparedSurface",
     "SurfaceQuality",
     "align_curves",

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-
+import numpy as np
 
 from . import _core
 from ._validate import as_choice, as_flag, as_integer, as_length, as_point, as_points, as_real
@@ -27,6 +27,39 @@ def _core_options(n, anchor, density_threshold, contact_tolerance, mesh_size, me
     )
 
 
+class PreparedCurve:
+    """A curve checked and indexed once, for several mappings of it (beyond the paper).
+
+    :func:`map_curves` and :func:`quality` take it wherever they take a curve; given two, they
+    skip their checks (simple: one loop, no self-intersection) and reuse the curves' query
+    indices, with the same results bit for bit. :func:`map_series` prepares each 2D frame once:
+    frame k is the target of one pair and the source of the next.
+
+    Parameters
+    ----------
+    points : (N, 2) float
+        A simple curve, as :func:`map_curves` wants (checked here; copied).
+    closed : bool
+        Whether it is closed; the calls it is passed to must ask for the same (``ValueError``
+        naming the argument otherwise).
+    name : str
+        How error messages name it.
+    """
+
+    def __init__(self, points, name: str = "curve", *, closed=True):
+        # A copy, read-only: the core holds its own, and a caller editing the array afterwards must
+        # not leave the two sides of a mixed call on different curves.
+        self.points = np.array(as_points(points, str(name)), copy=True)
+        self.points.flags.writeable = False
+        self.closed = as_flag(closed, "closed")
+        self._prepared = _core.PreparedCurve(self.points, self.closed, str(name))
+
+
+def as_curve(value, name: str) -> np.ndarray:
+    """The points of a curve given as an array or as a :class:`PreparedCurve`."""
+    return value.points if isinstance(value, PreparedCurve) else as_points(value, name)
+
+
 def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, transform=False,
                split=True, anchor=None, density_threshold=None, contact_tolerance=None,
                mesh_size=None, mesh_fraction=0.02, stretch_weight=None, skip_below=None,
@@ -35,9 +68,11 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
 
     Parameters
     ----------
-    c1, c2 : (N, 2) float
+    c1, c2 : (N, 2) float or PreparedCurve
         The curves, both closed unless ``closed=False`` (open curves are expected to run the same
-        way: start maps towards start).
+        way: start maps towards start). Two :class:`PreparedCurve` skip the checks and index
+        building they have done once (prepared as ``closed`` says); one alone is used as its
+        points.
     method : {"auto", "minimal_distance", "normal", "diffusion", "uniform", "optimal", "best"}
         ``"minimal_distance"``: each start point to its closest point on C2.
         ``"normal"``: the line through each start point along its normal, both directions, to its
@@ -143,14 +178,18 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
         # Checked here, as a candidate that refuses an option would only drop out of the choice.
         _core.validate_options(closed, **_core_options(n, anchor, density_threshold, contact_tolerance, mesh_size,
                                                         mesh_fraction, stretch_weight))
-        return map_best(c1, c2, closed=closed, n=n, split=split, anchor=anchor,
+        return map_best(as_curve(c1, "c1"), as_curve(c2, "c2"), closed=closed, n=n, split=split, anchor=anchor,
                         density_threshold=density_threshold, contact_tolerance=contact_tolerance,
                         mesh_size=mesh_size, mesh_fraction=mesh_fraction, stretch_weight=stretch_weight,
                         skip_below=skip_below, workers=workers)
     if skip_below is not None or workers is not None:
         raise ValueError("skip_below/workers: only for method 'best'")
     options = _core_options(n, anchor, density_threshold, contact_tolerance, mesh_size, mesh_fraction, stretch_weight)
-    c1 = as_points(c1, "c1")
-    record = _core.map_curves(c1, as_points(c2, "c2"), method, closed, reverse=as_flag(reverse, "reverse"),
-                              transform=as_flag(transform, "transform"), split=as_flag(split, "split"), **options)
-    return DisplacementField._from_core(record, source=c1, closed=closed)
+    source = as_curve(c1, "c1")
+    if isinstance(c1, PreparedCurve) and isinstance(c2, PreparedCurve):
+        core, curves = _core.map_prepared_curves, (c1._prepared, c2._prepared)
+    else:
+        core, curves = _core.map_curves, (source, as_curve(c2, "c2"))
+    record = core(*curves, method, closed, reverse=as_flag(reverse, "reverse"),
+                  transform=as_flag(transform, "transform"), split=as_flag(split, "split"), **options)
+    return DisplacementField._from_core(record, source=source, closed=closed)

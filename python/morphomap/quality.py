@@ -7,8 +7,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _core
-from ._validate import as_flag, as_points
+from ._validate import as_flag
 from .field import DisplacementField
+from .mapping import PreparedCurve, as_curve
 from .surfaces import PreparedSurface, as_surface
 
 
@@ -44,8 +45,9 @@ def quality(field, c1, c2, *, closed=True):
         A 2D field of vectors :math:`p_i \to P_i`; every valid start point must lie on ``c1`` and
         every valid end point on ``c2`` (within :math:`10^{-6}` of the curve's bounding-box
         diagonal).
-    c1, c2 : (N, 2) float
-        The curves at time t and t + dt. 3D: the closed surfaces S1 and S2, each a
+    c1, c2 : (N, 2) float or PreparedCurve
+        The curves at time t and t + dt (two :class:`PreparedCurve`, prepared as ``closed`` says,
+        skip their checks and reuse their indices; one alone is used as its points). 3D: the closed surfaces S1 and S2, each a
         ``trimesh.Trimesh``, a ``(vertices, faces)`` pair or a :class:`PreparedSurface`.
     closed : bool
         Whether both curves are closed (2D only).
@@ -130,8 +132,12 @@ def quality(field, c1, c2, *, closed=True):
         return SurfaceQuality(float(found["qm1"]), float(found["qm2"]), float(found["qm"]), int(found["folds"]))
     if field.dim != 2:
         raise ValueError(f"field: expected a 2D displacement field, got {field.dim}D")
-    c1 = as_points(c1, "c1")
-    c2 = as_points(c2, "c2")
-    closed = as_flag(closed, "closed")
-    found = _core.curve_quality(field.starts, field.ends, c1, c2, closed)
+    if isinstance(c1, PreparedCurve) and isinstance(c2, PreparedCurve):
+        found = _core.prepared_curve_quality(field.starts, field.ends, c1._prepared, c2._prepared,
+                                             as_flag(closed, "closed"))
+    else:
+        c1 = as_curve(c1, "c1")
+        c2 = as_curve(c2, "c2")
+        closed = as_flag(closed, "closed")
+        found = _core.curve_quality(field.starts, field.ends, c1, c2, closed)
     return CurveQuality(float(found["qm1"]), float(found["qm2"]), float(found["qm"]), int(found["crossings"]))

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import os
 import time
 from dataclasses import dataclass, field as dataclass_field
@@ -246,7 +247,7 @@ def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **op
         ``normal_speed``, ``accumulated_normal_speed``) and the quality per step.
     """
     from ._validate import as_length
-    from .mapping import map_curves
+    from .mapping import PreparedCurve, map_curves
     from .quality import quality
     from .surfaces import PreparedSurface, as_surface, map_surfaces
 
@@ -273,16 +274,17 @@ def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **op
     stretches, accumulated, speeds, mean_speeds = [], [], [], []
     normal_distance = np.zeros(len(born))  # summed since each point's birth
     fields, table = [], []
-    # Surfaces are checked and indexed once each (frame k is the target of one pair and the
-    # source of the next): PreparedSurface, two at a time.
-    prepared = None if curves[0] else PreparedSurface(frames[0], "frames[0]")
+    # Frames are checked and indexed once each (frame k is the target of one pair and the source
+    # of the next): PreparedCurve or PreparedSurface, two at a time, named as the pair's mapping
+    # names its curves or surfaces, so that a bad frame is reported as before, with its pair.
+    prepare = functools.partial(PreparedCurve, closed=closed) if curves[0] else PreparedSurface
+    roles = ("c1", "c2") if curves[0] else ("s1", "s2")
+    prepared = None
     for k in progress_over(range(len(frames) - 1), len(frames) - 1, progress, "map_series", "pair"):
-        a, b = frames[k], frames[k + 1]
         start = time.perf_counter()
-        if prepared is not None:
-            a, b = prepared, PreparedSurface(b, f"frames[{k + 1}]")
-            prepared = b
         try:
+            a = prepared if prepared is not None else prepare(frames[k], roles[0])
+            b = prepared = prepare(frames[k + 1], roles[1])
             field = (map_curves(a, b, method, **options) if curves[0]
                      else map_surfaces(a, b, method, progress=False, **options))
         except ValueError as error:

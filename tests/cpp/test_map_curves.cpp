@@ -1,16 +1,21 @@
 // map_curves against closed forms and brute force, as the Python tests check it: normal rays onto
 // a circle, minimal distance against every segment, uniform's exact proportions, the split at
-// the four crossings of two ellipses, reverse, the automatic workflow, and named bad input.
+// the four crossings of two ellipses, reverse, the automatic workflow, named bad input, and
+// prepared curves giving the plain calls' fields and quality bit for bit.
 #include <morphomap/crossings.hpp>
 #include <morphomap/errors.hpp>
 #include <morphomap/mapping.hpp>
+#include <morphomap/prepared_curve.hpp>
+#include <morphomap/quality.hpp>
 
 #include "check.hpp"
 #include "shapes.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <string>
+#include <vector>
 
 using morphomap::CurveMappingOptions;
 using morphomap::DisplacementField2;
@@ -20,6 +25,7 @@ using morphomap::map_curves;
 using morphomap::MapMethod;
 using morphomap::Method;
 using morphomap::Points2;
+using morphomap::PreparedCurve;
 using morphomap_test::pi;
 
 namespace {
@@ -154,6 +160,88 @@ void bad_curves_are_named() {
   CHECK(message_of(big, nan).rfind("c2:", 0) == 0);
 }
 
+// Equal arrays, NaN where the other is NaN.
+bool identical(const Points2& a, const Points2& b) {
+  return a.rows() == b.rows() && ((a.array() == b.array()) || (a.array().isNaN() && b.array().isNaN())).all();
+}
+
+bool same_number(double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); }
+
+// map_curves and quality on prepared curves (checked and indexed once) against the plain calls:
+// the same fields and quality, bit for bit, over the methods and the options that change which
+// curves the mapping runs on (resampled, moved) and which indices it may reuse.
+void prepared_curves_give_the_plain_results() {
+  Points2 wavy = ellipse(300, 1.4, 0.9);  // crosses the circle four times (split)
+  for (Index i = 0; i < wavy.rows(); ++i) wavy.row(i) *= 1.0 + 0.05 * std::sin(7 * 2 * pi * i / 300.0);
+  Points2 closing = ellipse(200, 1.0, 1.0, 0.1);  // a closing repeat of the first point
+  closing.conservativeResize(201, 2);
+  closing.row(200) = closing.row(0);
+  const Points2 outer = ellipse(250, 1.6, 1.3, 0.3);  // nested around both: no crossing
+  struct Pair {
+    const Points2 *c1, *c2;
+    bool closed;
+  };
+  const Points2 open1 = ellipse(80, 1.0, 1.0).topRows(40), open2 = ellipse(90, 1.3, 1.2).topRows(45);
+  const std::vector<Pair> pairs = {{&closing, &wavy, true}, {&closing, &outer, true}, {&open1, &open2, false}};
+  for (const Pair& pair : pairs) {
+    const PreparedCurve p1(*pair.c1, pair.closed, "frame 1"), p2(*pair.c2, pair.closed, "frame 2");
+    CHECK(p1.points() == *pair.c1 && p1.closed() == pair.closed);
+    for (const MapMethod method : {MapMethod::automatic, MapMethod::normal, MapMethod::minimal_distance,
+                                   MapMethod::uniform, MapMethod::diffusion, MapMethod::optimal}) {
+      for (int variant = 0; variant < 4; ++variant) {
+        CurveMappingOptions options;
+        options.method = method;
+        options.closed = pair.closed;
+        options.reverse = variant == 1;
+        options.n = variant == 2 ? 120 : 0;
+        options.transform = variant == 3;
+        DisplacementField2 plain;
+        try {
+          plain = map_curves(*pair.c1, *pair.c2, options);
+        } catch (const std::exception& refused) {  // then refused alike
+          try {
+            map_curves(p1, p2, options);
+            CHECK(false);
+          } catch (const std::exception& e) {
+            CHECK(std::string(e.what()) == refused.what());
+          }
+          continue;
+        }
+        const DisplacementField2 prepared = map_curves(p1, p2, options);
+        CHECK(identical(prepared.starts, plain.starts) && identical(prepared.ends, plain.ends));
+        CHECK(prepared.methods == plain.methods);
+        const morphomap::CurveQuality a = morphomap::quality(plain, *pair.c1, *pair.c2, pair.closed);
+        const morphomap::CurveQuality b = morphomap::quality(prepared, p1, p2, pair.closed);
+        CHECK(same_number(a.qm1, b.qm1) && same_number(a.qm2, b.qm2) && same_number(a.qm, b.qm));
+        CHECK(a.crossings == b.crossings);
+      }
+    }
+  }
+  // Prepared open, asked closed (or the other way round): named; a bad curve: named as prepared.
+  const PreparedCurve circle(ellipse(50, 1.0, 1.0), true, "frame 1"), arc(open1, false, "frame 2");
+  CurveMappingOptions closed;
+  try {
+    map_curves(circle, arc, closed);
+    CHECK(false);
+  } catch (const InvalidInput& e) {
+    CHECK(std::string(e.what()).rfind("c2: was prepared as an open curve", 0) == 0);
+  }
+  const DisplacementField2 field = map_curves(circle, circle, closed);
+  CHECK_THROWS(morphomap::quality(field, arc, circle, true), InvalidInput);
+  try {
+    morphomap::quality(field, circle, circle, false);
+    CHECK(false);
+  } catch (const InvalidInput& e) {
+    CHECK(std::string(e.what()).rfind("c1: was prepared as a closed curve", 0) == 0);
+  }
+  try {
+    const PreparedCurve bad(morphomap_test::pts({{0, 0}, {1, 1}, {1, 0}, {0, 1}}), true, "frames[3]");
+    CHECK(false);
+  } catch (const InvalidInput& e) {
+    CHECK(std::string(e.what()).rfind("frames[3]: the curve intersects itself", 0) == 0);
+  }
+}
+
 }  // namespace
 
 int main() {
@@ -164,5 +252,6 @@ int main() {
   reverse_starts_on_c1_in_c2_order();
   automatic_maps_concentric_circles_radially();
   bad_curves_are_named();
+  prepared_curves_give_the_plain_results();
   TEST_MAIN_END();
 }

@@ -3,6 +3,7 @@
 #include <morphomap/field.hpp>
 #include <morphomap/laplace.hpp>
 #include <morphomap/optimal.hpp>
+#include <morphomap/prepared_curve.hpp>
 #include <morphomap/types.hpp>
 
 #include <optional>
@@ -47,6 +48,11 @@ struct CurveMappingOptions {
 // ones. With n > 0 the start and end points are put onto c1 and c2 as given (the resampled
 // curves cut their corners).
 DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2, const CurveMappingOptions& options = {});
+// The same on curves checked and indexed once (not checked again; their indices are reused),
+// with the same result bit for bit. Both must have been prepared as options.closed asks
+// (InvalidInput naming "c1" or "c2" otherwise).
+DisplacementField2 map_curves(const PreparedCurve& c1, const PreparedCurve& c2,
+                              const CurveMappingOptions& options = {});
 
 // The checks of the options that map_curves makes (after the curves', before any work):
 // InvalidInput naming the option. For callers that run several mappings with one set of options.

@@ -13,6 +13,7 @@
 #include <morphomap/laplace3d.hpp>
 #include <morphomap/mapping.hpp>
 #include <morphomap/optimal.hpp>
+#include <morphomap/prepared_curve.hpp>
 #include <morphomap/prepared_surface.hpp>
 #include <morphomap/quality.hpp>
 #include <morphomap/remesh.hpp>

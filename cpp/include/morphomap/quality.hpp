@@ -1,6 +1,7 @@
 #pragma once
 // The paper's quality measures of a 2D displacement field (section "Quantitative Evaluation").
 #include <morphomap/field.hpp>
+#include <morphomap/prepared_curve.hpp>
 #include <morphomap/prepared_surface.hpp>
 #include <morphomap/surface_queries.hpp>
 #include <morphomap/types.hpp>
@@ -36,6 +37,10 @@ struct CurveQuality {
 // Cost: a bounding-volume hierarchy per curve to find the arc position of each point, then
 // O(M + vertices walked) in parallel; each area walks only the vertices between two points.
 CurveQuality quality(const DisplacementField2& field, const Points2Ref& c1, const Points2Ref& c2, bool closed = true);
+// The same on curves checked and indexed once (their indices are reused), bit for bit; both must
+// have been prepared as `closed` asks (InvalidInput naming "c1" or "c2" otherwise).
+CurveQuality quality(const DisplacementField2& field, const PreparedCurve& c1, const PreparedCurve& c2,
+                     bool closed = true);
 
 }  // namespace morphomap
 

@@ -580,12 +580,25 @@ std::pair<Points2, Points2> piece_polylines(const ArcCurve& source, const ArcCur
   return {std::move(piece_source), std::move(piece_target)};
 }
 
+// The query index of `curve` (a checked curve): `given` (a PreparedCurve's, not owned) where it
+// indexes exactly these points, else one built here. A prepared curve's index covers the points
+// that take part of the curve as given; `curve` is always a leading part of those rows, so equal
+// sizes mean equal indices (and equal answers, bit for bit).
+std::shared_ptr<const CurveIndex> index_of(const Points2Ref& curve, bool closed, const CurveIndex* given) {
+  if (given != nullptr && given->closed() == closed && given->size() == detail::curve_size(curve, closed)) {
+    return std::shared_ptr<const CurveIndex>(std::shared_ptr<const CurveIndex>(), given);
+  }
+  return std::make_shared<const CurveIndex>(Unchecked::build(curve, closed));
+}
+
+// source_given, target_given: the curves' indices where the caller has them (see index_of).
 Vectors map_directed(const Points2& source_points, const Points2& target_points, MapMethod method, bool closed,
-                     bool split, const std::optional<std::pair<Vec2, Vec2>>& anchors, const Settings& settings) {
+                     bool split, const std::optional<std::pair<Vec2, Vec2>>& anchors, const Settings& settings,
+                     const CurveIndex* source_given, const CurveIndex* target_given) {
   const ArcCurve source = ArcCurve::unchecked(source_points, closed);
   const ArcCurve target = ArcCurve::unchecked(target_points, closed);
-  const auto whole_source_index = std::make_shared<const CurveIndex>(Unchecked::build(source.points(), closed));
-  const auto whole_target_index = std::make_shared<const CurveIndex>(Unchecked::build(target.points(), closed));
+  const auto whole_source_index = index_of(source.points(), closed, source_given);
+  const auto whole_target_index = index_of(target.points(), closed, target_given);
   const Index n = source.size();
   const bool wants_normals = method == MapMethod::normal || method == MapMethod::automatic;
   const Points2 source_normals = wants_normals ? detail::normals_unchecked(source.points(), closed) : Points2();
@@ -694,11 +707,11 @@ Vectors map_directed(const Points2& source_points, const Points2& target_points,
 }
 
 // Puts the finite rows of points onto the curve (their closest points).
-void project_onto(Points2& points, const Points2Ref& curve, bool closed) {
+void project_onto(Points2& points, const Points2Ref& curve, bool closed, const CurveIndex* given) {
   const std::vector<Index> rows = detail::finite_rows(points);
   if (rows.empty()) return;
   const Points2 queries = points(rows, Eigen::all);
-  const Points2 on_curve = Unchecked::closest_points(Unchecked::build(curve, closed), queries).points;
+  const Points2 on_curve = Unchecked::closest_points(*index_of(curve, closed, given), queries).points;
   for (std::size_t j = 0; j < rows.size(); ++j) points.row(rows[j]) = on_curve.row(j);
 }
 
@@ -723,22 +736,26 @@ void validate_options(const CurveMappingOptions& options) {
   }
 }
 
-DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2, const CurveMappingOptions& options) {
+namespace {
+
+// map_curves after its curves' checks: c1, c2 passed require_simple_curve, n1, n2 points of
+// them take part, and index1, index2 are their query indices where the caller has them
+// (PreparedCurve), else null.
+DisplacementField2 mapped(const Points2Ref& c1, Index n1, const CurveIndex* index1, const Points2Ref& c2, Index n2,
+                          const CurveIndex* index2, const CurveMappingOptions& options) {
   const bool closed = options.closed;
-  const Index n1 = detail::require_simple_curve(c1, closed, "c1");
-  const Index n2 = detail::require_simple_curve(c2, closed, "c2");
   validate_options(options);
   // Frames of one organ overlap; closed curves that neither cross nor nest are the wrong pair
   // (other units, another offset), whatever a method would make of them.
   // (Each curve's point farthest from the other decides: a touching point would not.)
-  auto farthest = [](const Points2Ref& points, const Points2Ref& curve) -> Vec2 {
+  auto farthest = [](const Points2Ref& points, const Points2Ref& curve, const CurveIndex* given) -> Vec2 {
     Index at = 0;
-    Unchecked::closest_points(Unchecked::build(curve, true), points).distances.maxCoeff(&at);
+    Unchecked::closest_points(*index_of(curve, true, given), points).distances.maxCoeff(&at);
     return points.row(at).transpose();
   };
   if (closed && detail::curve_intersections_unchecked(c1.topRows(n1), c2.topRows(n2), true).points.rows() == 0 &&
-      !detail::inside(farthest(c1.topRows(n1), c2.topRows(n2)), c2.topRows(n2)) &&
-      !detail::inside(farthest(c2.topRows(n2), c1.topRows(n1)), c1.topRows(n1))) {
+      !detail::inside(farthest(c1.topRows(n1), c2.topRows(n2), index2), c2.topRows(n2)) &&
+      !detail::inside(farthest(c2.topRows(n2), c1.topRows(n1), index1), c1.topRows(n1))) {
     detail::invalid("c2",
                     "lies apart from c1 (the curves neither cross nor enclose one another): consecutive "
                     "frames of one organ overlap; check their units and offsets");
@@ -752,7 +769,7 @@ DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2, const 
     a = similarity.apply(a);
   }
   // Resampled or moved curves are new curves: checked once here as the core's functions check
-  // theirs (the given ones passed require_simple_curve above).
+  // theirs (the given ones passed require_simple_curve, at the entry or when prepared).
   const bool derived = options.n > 0 || options.transform;
   if (derived) {
     detail::require_curve(a, closed, "c1");
@@ -773,8 +790,12 @@ DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2, const 
   settings.diffusion = options.diffusion;
   settings.stretch_weight = options.stretch_weight;
   settings.simple_curves = !derived;
-  Vectors v = options.reverse ? map_directed(b, a, options.method, closed, options.split, anchors, settings)
-                              : map_directed(a, b, options.method, closed, options.split, anchors, settings);
+  // The given curves' indices serve where the mapping runs on those curves (not resampled or moved).
+  const CurveIndex* index_a = derived ? nullptr : index1;
+  const CurveIndex* index_b = options.n > 0 ? nullptr : index2;
+  Vectors v = options.reverse
+                  ? map_directed(b, a, options.method, closed, options.split, anchors, settings, index_b, index_a)
+                  : map_directed(a, b, options.method, closed, options.split, anchors, settings, index_a, index_b);
   DisplacementField2 field;
   field.starts = std::move(options.reverse ? v.ends : v.starts);
   field.ends = std::move(options.reverse ? v.starts : v.ends);
@@ -786,10 +807,27 @@ DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2, const 
   // Resampled curves cut the corners of the given ones: the points found on them go onto the
   // curves the caller passed, so that quality(field, c1, c2) measures the field on those.
   if (options.n > 0) {
-    project_onto(field.starts, c1.topRows(n1), closed);
-    project_onto(field.ends, c2.topRows(n2), closed);
+    project_onto(field.starts, c1.topRows(n1), closed, index1);
+    project_onto(field.ends, c2.topRows(n2), closed, index2);
   }
   return field;
+}
+
+}  // namespace
+
+DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2, const CurveMappingOptions& options) {
+  const Index n1 = detail::require_simple_curve(c1, options.closed, "c1");
+  const Index n2 = detail::require_simple_curve(c2, options.closed, "c2");
+  return mapped(c1, n1, nullptr, c2, n2, nullptr, options);
+}
+
+DisplacementField2 map_curves(const PreparedCurve& c1, const PreparedCurve& c2, const CurveMappingOptions& options) {
+  c1.require_closed(options.closed, "c1");
+  c2.require_closed(options.closed, "c2");
+  const Points2& p1 = c1.points();
+  const Points2& p2 = c2.points();
+  return mapped(p1, detail::curve_size(p1, options.closed), &c1.index(), p2, detail::curve_size(p2, options.closed),
+                &c2.index(), options);
 }
 
 CurveSplit split_curves(const Points2Ref& c1, const Points2Ref& c2, bool closed, bool split, double contact_tolerance) {

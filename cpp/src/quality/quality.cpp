@@ -38,13 +38,13 @@ struct Located {
 
 double diagonal(const Points2Ref& points) { return (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm(); }
 
-Located locate(const Points2& points, const std::vector<Index>& rows, const ArcCurve& curve, const Points2Ref& raw,
+// index: the curve's query index (built from the curve as given, or a PreparedCurve's).
+Located locate(const Points2& points, const std::vector<Index>& rows, const ArcCurve& curve, const CurveIndex& index,
                const char* which, const char* curve_name, Index total) {
   Points2 queries(static_cast<Index>(rows.size()), 2);
   for (std::size_t k = 0; k < rows.size(); ++k) queries.row(k) = points.row(rows[k]);
-  // raw passed ArcCurve's checks at quality's entry; the rows are the field's finite ones.
-  const CurveHits hits =
-      detail::CurveIndexUnchecked::closest_points(detail::CurveIndexUnchecked::build(raw, curve.closed()), queries);
+  // The rows are the field's finite ones.
+  const CurveHits hits = detail::CurveIndexUnchecked::closest_points(index, queries);
 
   const double tol = kOnCurve * diagonal(curve.points());
   for (std::size_t k = 0; k < rows.size(); ++k) {
@@ -114,24 +114,28 @@ double finite_mean(const std::vector<double>& values) {
   return count > 0 ? sum / static_cast<double>(count) : kNaN;
 }
 
-}  // namespace
-
-CurveQuality quality(const DisplacementField2& field, const Points2Ref& c1, const Points2Ref& c2, bool closed) {
-  const Index m = field.size();
-  if (field.ends.rows() != m) {
-    detail::invalid(
-        "field", "has " + std::to_string(m) + " start points but " + std::to_string(field.ends.rows()) + " end points");
+void require_as_many_ends(const DisplacementField2& field) {
+  if (field.ends.rows() != field.size()) {
+    detail::invalid("field", "has " + std::to_string(field.size()) + " start points but " +
+                                 std::to_string(field.ends.rows()) + " end points");
   }
-  const ArcCurve curve1(c1, closed, "c1");
-  const ArcCurve curve2(c2, closed, "c2");
+}
+
+// quality after its checks: c1 and c2 passed require_curve, index1 and index2 are built from them
+// as given.
+CurveQuality checked_quality(const DisplacementField2& field, const Points2Ref& c1, const CurveIndex& index1,
+                             const Points2Ref& c2, const CurveIndex& index2, bool closed) {
+  const Index m = field.size();
+  const ArcCurve curve1 = ArcCurve::unchecked(c1, closed);
+  const ArcCurve curve2 = ArcCurve::unchecked(c2, closed);
 
   std::vector<Index> rows;
   rows.reserve(m);
   for (Index i = 0; i < m; ++i) {
     if (field.valid(i)) rows.push_back(i);
   }
-  const Located at1 = locate(field.starts, rows, curve1, c1, "start", "c1", m);
-  const Located at2 = locate(field.ends, rows, curve2, c2, "end", "c2", m);
+  const Located at1 = locate(field.starts, rows, curve1, index1, "start", "c1", m);
+  const Located at2 = locate(field.ends, rows, curve2, index2, "end", "c2", m);
 
   const double alpha = curve2.length() / curve1.length();
   const Index pairs = closed && m >= 2 ? m : std::max<Index>(m - 1, 0);
@@ -180,6 +184,23 @@ CurveQuality quality(const DisplacementField2& field, const Points2Ref& c1, cons
   q.qm = q.qm1 * q.qm2;
   q.crossings = count_crossings(field.starts, field.ends);
   return q;
+}
+
+}  // namespace
+
+CurveQuality quality(const DisplacementField2& field, const Points2Ref& c1, const Points2Ref& c2, bool closed) {
+  require_as_many_ends(field);
+  detail::require_curve(c1, closed, "c1");
+  detail::require_curve(c2, closed, "c2");
+  return checked_quality(field, c1, detail::CurveIndexUnchecked::build(c1, closed), c2,
+                         detail::CurveIndexUnchecked::build(c2, closed), closed);
+}
+
+CurveQuality quality(const DisplacementField2& field, const PreparedCurve& c1, const PreparedCurve& c2, bool closed) {
+  require_as_many_ends(field);
+  c1.require_closed(closed, "c1");
+  c2.require_closed(closed, "c2");
+  return checked_quality(field, c1.points(), c1.index(), c2.points(), c2.index(), closed);
 }
 
 }  // namespace morphomap
