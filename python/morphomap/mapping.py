@@ -38,12 +38,12 @@ class PreparedCurve:
     Parameters
     ----------
     points : (N, 2) float
-        A simple curve, as :func:`map_curves` wants (checked here; copied).
+        A simple curve, as :func:`map_curves` wants (checked here; copied as given).
+    name : str
+        How error messages name it.
     closed : bool
         Whether it is closed; the calls it is passed to must ask for the same (``ValueError``
         naming the argument otherwise).
-    name : str
-        How error messages name it.
     """
 
     def __init__(self, points, name: str = "curve", *, closed=True):

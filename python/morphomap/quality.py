@@ -47,8 +47,9 @@ def quality(field, c1, c2, *, closed=True):
         diagonal).
     c1, c2 : (N, 2) float or PreparedCurve
         The curves at time t and t + dt (two :class:`PreparedCurve`, prepared as ``closed`` says,
-        skip their checks and reuse their indices; one alone is used as its points). 3D: the closed surfaces S1 and S2, each a
-        ``trimesh.Trimesh``, a ``(vertices, faces)`` pair or a :class:`PreparedSurface`.
+        skip their checks and reuse their indices; one alone is used as its points). 3D: the
+        closed surfaces S1 and S2, each a ``trimesh.Trimesh``, a ``(vertices, faces)`` pair or a
+        :class:`PreparedSurface`.
     closed : bool
         Whether both curves are closed (2D only).
 
