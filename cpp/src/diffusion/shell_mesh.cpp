@@ -179,12 +179,14 @@ Nesting classify_nesting(const ClosedSurface& source_surface, const ClosedSurfac
     const SurfaceMesh& source = source_surface.mesh().surface;
     const SurfaceMesh& target = target_surface.mesh().surface;
     // Mesh_3 on a self-intersecting surface may crash rather than fail.
-    if (CGAL::Polygon_mesh_processing::does_self_intersect(source)) {
+    if (!source_surface.known_simple() && CGAL::Polygon_mesh_processing::does_self_intersect(source)) {
       throw InvalidInput(std::string("s1: ") + kSelfIntersecting);
     }
-    if (CGAL::Polygon_mesh_processing::does_self_intersect(target)) {
+    source_surface.mark_simple();
+    if (!target_surface.known_simple() && CGAL::Polygon_mesh_processing::does_self_intersect(target)) {
       throw InvalidInput(std::string("s2: ") + kSelfIntersecting);
     }
+    target_surface.mark_simple();
     if (CGAL::Polygon_mesh_processing::do_intersect(source, target)) return Nesting::crossing;
     const CGAL::Side_of_triangle_mesh<SurfaceMesh, Kernel> in_target(target), in_source(source);
     const Point s = source.point(*source.vertices().begin());
