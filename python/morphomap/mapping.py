@@ -150,7 +150,8 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
     if skip_below is not None or workers is not None:
         raise ValueError("skip_below/workers: only for method 'best'")
     options = _core_options(n, anchor, density_threshold, contact_tolerance, mesh_size, mesh_fraction, stretch_weight)
-    c1 = as_points(c1, "c1")
-    record = _core.map_curves(c1, as_points(c2, "c2"), method, closed, reverse=as_flag(reverse, "reverse"),
+    # Finiteness is the core's rule (require_curve, the same message): converted only here.
+    c1, c2 = as_points(c1, "c1", allow_nan=True), as_points(c2, "c2", allow_nan=True)
+    record = _core.map_curves(c1, c2, method, closed, reverse=as_flag(reverse, "reverse"),
                               transform=as_flag(transform, "transform"), split=as_flag(split, "split"), **options)
     return DisplacementField._from_core(record, source=c1, closed=closed)
