@@ -167,13 +167,6 @@ ClosedSurface::ClosedSurface(const Points3Ref& vertices, const FacesRef& faces)
     : mesh_(std::make_unique<Mesh>(Mesh{to_surface_mesh(vertices, faces)})) {}
 ClosedSurface::~ClosedSurface() = default;
 
-Nesting classify_nesting(const Points3Ref& source_vertices, const FacesRef& source_faces,
-                         const Points3Ref& target_vertices, const FacesRef& target_faces) {
-  const ClosedSurface source(source_vertices, source_faces);
-  const ClosedSurface target(target_vertices, target_faces);
-  return classify_nesting(source, target);
-}
-
 Nesting classify_nesting(const ClosedSurface& source_surface, const ClosedSurface& target_surface) {
   try {
     const SurfaceMesh& source = source_surface.mesh().surface;

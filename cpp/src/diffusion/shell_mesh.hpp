@@ -42,9 +42,6 @@ inline Nesting swapped(Nesting nesting) {
   if (nesting == Nesting::target_inside) return Nesting::source_inside;
   return nesting;
 }
-// The same from the arrays (for a caller that has no other use for the conversion).
-Nesting classify_nesting(const Points3Ref& source_vertices, const FacesRef& source_faces,
-                         const Points3Ref& target_vertices, const FacesRef& target_faces);
 
 // For each query point: whether it lies inside the closed, outward-oriented surface (exact
 // predicates, so points within rounding of the surface are still told apart); on it counts as inside.
