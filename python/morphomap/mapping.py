@@ -48,16 +48,16 @@ class PreparedCurve:
 
     def __init__(self, points, name: str = "curve", *, closed=True):
         # A copy, read-only: the core holds its own, and a caller editing the array afterwards must
-        # not leave the two sides of a mixed call on different curves.
-        self.points = np.array(as_points(points, str(name)), copy=True)
+        # not leave the two sides of a mixed call on different curves. Finiteness is the core's rule.
+        self.points = np.array(as_points(points, str(name), allow_nan=True), copy=True)
         self.points.flags.writeable = False
         self.closed = as_flag(closed, "closed")
         self._prepared = _core.PreparedCurve(self.points, self.closed, str(name))
 
 
-def as_curve(value, name: str) -> np.ndarray:
+def as_curve(value, name: str, *, allow_nan: bool = False) -> np.ndarray:
     """The points of a curve given as an array or as a :class:`PreparedCurve`."""
-    return value.points if isinstance(value, PreparedCurve) else as_points(value, name)
+    return value.points if isinstance(value, PreparedCurve) else as_points(value, name, allow_nan=allow_nan)
 
 
 def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, transform=False,
@@ -185,11 +185,12 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
     if skip_below is not None or workers is not None:
         raise ValueError("skip_below/workers: only for method 'best'")
     options = _core_options(n, anchor, density_threshold, contact_tolerance, mesh_size, mesh_fraction, stretch_weight)
-    source = as_curve(c1, "c1")
+    # Finiteness is the core's rule (require_curve, the same message): converted only here.
+    source = as_curve(c1, "c1", allow_nan=True)
     if isinstance(c1, PreparedCurve) and isinstance(c2, PreparedCurve):
         core, curves = _core.map_prepared_curves, (c1._prepared, c2._prepared)
     else:
-        core, curves = _core.map_curves, (source, as_curve(c2, "c2"))
+        core, curves = _core.map_curves, (source, as_curve(c2, "c2", allow_nan=True))
     record = core(*curves, method, closed, reverse=as_flag(reverse, "reverse"),
                   transform=as_flag(transform, "transform"), split=as_flag(split, "split"), **options)
     return DisplacementField._from_core(record, source=source, closed=closed)

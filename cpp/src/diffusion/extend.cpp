@@ -311,47 +311,55 @@ double default_size(const DisplacementField3& field, const ExtendOptions& option
   return options.mesh_size > 0.0 ? options.mesh_size : total / (3.0 * field.faces.rows());
 }
 
+// The field on the given mesh (checked), or with no cells given on the one `make_mesh` puts into
+// the result: boundary values from `values_at`, then the solve (the same in 2D and 3D).
+template <int D, class Out, class PointsRef, class CellsRef, class MakeMesh, class ValuesAt>
+Out extend_on(const PointsRef& mesh_points, const CellsRef& mesh_cells, MakeMesh make_mesh, ValuesAt values_at,
+              const ExtendOptions& options) {
+  Out out;
+  if (mesh_cells.rows() == 0) {
+    make_mesh(out);
+  } else {
+    require_mesh(mesh_points, mesh_cells);
+    out.points = mesh_points;
+    out.cells = mesh_cells;
+  }
+  const std::vector<char> fixed = boundary_nodes(out.cells, out.points.rows());
+  take_boundary_values(out, fixed, values_at);
+  solve_motion<D>(out, fixed, options);
+  return out;
+}
+
 }  // namespace
 
 InteriorField2 extend_field(const DisplacementField2& field, const Points2Ref& source, const Points2Ref& mesh_points,
                             const FacesRef& mesh_cells, const ExtendOptions& options) {
   require_options(options);
   detail::require_simple_curve(source, true, "source");
-  InteriorField2 out;
-  if (mesh_cells.rows() == 0) {
-    const detail::RegionMesh mesh =
-        detail::mesh_region({detail::without_repeats(source, true, "source")}, options.mesh_size);
-    out.points = mesh.vertices;
-    out.cells = mesh.triangles;
-  } else {
-    require_mesh(mesh_points, mesh_cells);
-    out.points = mesh_points;
-    out.cells = mesh_cells;
-  }
-  const std::vector<char> fixed = boundary_nodes(out.cells, out.points.rows());
-  take_boundary_values(out, fixed, [&](const Points2& at) { return displacement_at(field, source, true, at); });
-  solve_motion<2>(out, fixed, options);
-  return out;
+  return extend_on<2, InteriorField2>(
+      mesh_points, mesh_cells,
+      [&](InteriorField2& out) {
+        // (require_simple_curve has checked the curve: only its repeats are dropped here.)
+        detail::RegionMesh mesh =
+            detail::mesh_region({detail::drop_repeats(source, true, "source")}, options.mesh_size);
+        out.points = std::move(mesh.vertices);
+        out.cells = std::move(mesh.triangles);
+      },
+      [&](const Points2& at) { return displacement_at(field, source, true, at); }, options);
 }
 
 InteriorField3 extend_field(const DisplacementField3& field, const Points3Ref& mesh_points,
                             const TetrahedraRef& mesh_cells, const ExtendOptions& options) {
   require_options(options);
-  InteriorField3 out;
-  if (mesh_cells.rows() == 0) {
-    const detail::VolumeMesh mesh =
-        detail::mesh_volume(field.starts, field.faces, default_size(field, options), options.seed, "field");
-    out.points = mesh.vertices;
-    out.cells = mesh.tetrahedra;
-  } else {
-    require_mesh(mesh_points, mesh_cells);
-    out.points = mesh_points;
-    out.cells = mesh_cells;
-  }
-  const std::vector<char> fixed = boundary_nodes(out.cells, out.points.rows());
-  take_boundary_values(out, fixed, [&](const Points3& at) { return displacement_at(field, at); });
-  solve_motion<3>(out, fixed, options);
-  return out;
+  return extend_on<3, InteriorField3>(
+      mesh_points, mesh_cells,
+      [&](InteriorField3& out) {
+        detail::VolumeMesh mesh =
+            detail::mesh_volume(field.starts, field.faces, default_size(field, options), options.seed, "field");
+        out.points = std::move(mesh.vertices);
+        out.cells = std::move(mesh.tetrahedra);
+      },
+      [&](const Points3& at) { return displacement_at(field, at); }, options);
 }
 
 }  // namespace morphomap

@@ -54,15 +54,16 @@ using detail::source_vertex;
 using detail::target_vertex;
 
 struct SurfaceFacts {
-  double volume = 0.0;  // signed: positive when the faces are oriented outwards
+  double volume = 0.0;  // positive: the faces are oriented outwards
   double area = 0.0;
   double mean_edge = 0.0;
 };
 
-// Checks the surface (closed, consistently oriented; see check_closed_surface) and measures it.
-SurfaceFacts check_surface(const Points3Ref& vertices, const FacesRef& faces, const char* name) {
+// Measures a surface that passed check_closed_surface (`volume`: the size of its volume). Its
+// faces may enclose no volume at all: no region to mesh then.
+SurfaceFacts measure_surface(const Points3Ref& vertices, const FacesRef& faces, double volume, const char* name) {
   SurfaceFacts facts;
-  facts.volume = check_closed_surface(vertices, faces, name);
+  facts.volume = volume;
   for (Index f = 0; f < faces.rows(); ++f) {
     const Vec3 a = vertices.row(faces(f, 0)).transpose(), b = vertices.row(faces(f, 1)).transpose(),
                c = vertices.row(faces(f, 2)).transpose();
@@ -71,7 +72,7 @@ SurfaceFacts check_surface(const Points3Ref& vertices, const FacesRef& faces, co
   }
   facts.mean_edge /= faces.rows();
   const double scale = (vertices.colwise().maxCoeff() - vertices.colwise().minCoeff()).norm();
-  if (!(std::abs(facts.volume) > 1e-12 * scale * scale * scale)) detail::invalid(name, "encloses no volume");
+  if (!(facts.volume > 1e-12 * scale * scale * scale)) detail::invalid(name, "encloses no volume");
   return facts;
 }
 
@@ -369,42 +370,50 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, const FacesRef& source_faces,
                                           const Points3Ref& target_vertices, const FacesRef& target_faces,
                                           const ShellDiffusionOptions& options) {
-  return detail::solve_diffusion_3d(source_vertices, source_faces, target_vertices, target_faces, options, nullptr);
-}
-
-ShellDiffusionSolution detail::solve_diffusion_3d(const Points3Ref& source_vertices, const FacesRef& source_faces,
-                                                  const Points3Ref& target_vertices, const FacesRef& target_faces,
-                                                  const ShellDiffusionOptions& options,
-                                                  const SurfaceIndex* given_target_index) {
   if (!(options.mesh_size >= 0.0) || !std::isfinite(options.mesh_size)) {
     detail::invalid("mesh_size", "must be a finite length >= 0");
   }
-  const SurfaceFacts source = check_surface(source_vertices, source_faces, "s1");
-  const SurfaceFacts target = check_surface(target_vertices, target_faces, "s2");
+  const auto clock = std::chrono::steady_clock::now();
+  const double source_volume = check_closed_surface(source_vertices, source_faces, "s1");
+  const double target_volume = check_closed_surface(target_vertices, target_faces, "s2");
   // Mesh_3 and the nesting tests want outward orientation.
   Faces source_out = source_faces, target_out = target_faces;
-  if (source.volume < 0.0) source_out.col(1).swap(source_out.col(2));
-  if (target.volume < 0.0) target_out.col(1).swap(target_out.col(2));
+  if (source_volume < 0.0) source_out.col(1).swap(source_out.col(2));
+  if (target_volume < 0.0) target_out.col(1).swap(target_out.col(2));
+  // Each surface in CGAL's form once, for the nesting, contact, crossing and meshing steps.
+  const detail::ClosedSurface source(source_vertices, source_out);
+  const detail::ClosedSurface target(target_vertices, target_out);
+  const detail::Nesting nesting = detail::classify_nesting(source, target);
+  if (nesting == detail::Nesting::disjoint) {
+    throw InvalidInput("s2: diffusion mapping needs surfaces that overlap (these lie apart)");
+  }
+  const SurfaceIndex target_index(target_vertices, target_out);
+  const double nesting_seconds = seconds_since(clock);
+  ShellDiffusionSolution solution = detail::solve_diffusion_3d(
+      detail::ShellPair{source_vertices, source_out, target_vertices, target_out, source, target,
+                        std::abs(source_volume), std::abs(target_volume), nesting, target_index},
+      options);
+  solution.seconds.mesh += nesting_seconds;  // the nesting test is part of the meshing stage
+  return solution;
+}
 
+ShellDiffusionSolution detail::solve_diffusion_3d(const ShellPair& pair, const ShellDiffusionOptions& options) {
+  const Points3Ref& source_vertices = pair.source_vertices;
+  const Points3Ref& target_vertices = pair.target_vertices;
+  const SurfaceFacts source = measure_surface(source_vertices, pair.source_faces, pair.source_volume, "s1");
+  const SurfaceFacts target = measure_surface(target_vertices, pair.target_faces, pair.target_volume, "s2");
   const auto stage = [&](const char* name) {
     if (options.on_stage) options.on_stage(name);
   };
   stage("mesh");
   auto clock = std::chrono::steady_clock::now();
-  // Each surface in CGAL's form once, for the nesting, contact, crossing and meshing steps.
-  const detail::ClosedSurface given_source(source_vertices, source_out);
-  const detail::ClosedSurface target_surface(target_vertices, target_out);
-  detail::Nesting nesting = detail::classify_nesting(given_source, target_surface);
-  if (nesting == detail::Nesting::disjoint) {
-    throw InvalidInput("s2: diffusion mapping needs surfaces that overlap (these lie apart)");
-  }
-  std::unique_ptr<const SurfaceIndex> own_target_index;
-  if (given_target_index == nullptr)
-    own_target_index = std::make_unique<const SurfaceIndex>(target_vertices, target_faces);
-  const SurfaceIndex& target_index = given_target_index ? *given_target_index : *own_target_index;
+  detail::Nesting nesting = pair.nesting;
+  const detail::ClosedSurface& given_source = pair.source;
+  const detail::ClosedSurface& target_surface = pair.target;
+  const SurfaceIndex& target_index = pair.target_index;
   const double finer_edge = std::min(source.mean_edge, target.mean_edge);
-  const Cleared cleared_pair = clear_and_classify(source_vertices, source_out, target_vertices, target_out,
-                                                  target_surface, target_index, finer_edge, nesting);
+  const Cleared cleared_pair = clear_and_classify(source_vertices, pair.source_faces, target_vertices,
+                                                  pair.target_faces, target_surface, target_index, finer_edge, nesting);
   const detail::ClearedSource& cleared = cleared_pair.source;
   nesting = cleared_pair.nesting;
   // Bodies that only touch from outside count as crossing until the contact is cleared.
@@ -426,7 +435,7 @@ ShellDiffusionSolution detail::solve_diffusion_3d(const Points3Ref& source_verti
   // the surfaces). Measured between spheres of radii 1 and 4: the end-point error falls about
   // linearly with the element size in the bulk, and removing slivers (exude) buys more accuracy
   // than it costs time.
-  const double volume = crossing ? crossing->volume() : std::abs(std::abs(target.volume) - std::abs(source.volume));
+  const double volume = crossing ? crossing->volume() : std::abs(target.volume - source.volume);
   // Where the surfaces touch, they bound no region: leave that part out of the mean.
   const double gap = volume / std::max(0.5 * (source.area + target.area) - cleared.near_area, 0.05 * source.area);
   detail::ShellMeshCriteria criteria;

@@ -1,15 +1,32 @@
 #pragma once
-// solve_diffusion_3d for callers that already hold the target's query index (map_surfaces), so
-// that one Embree scene of S2 serves the mapping, the diffusion's end points and the fold repair.
+// solve_diffusion_3d for map_surfaces, which has checked both surfaces, converted them to CGAL's
+// form and classified their nesting at its entry (the self-intersection tests are a fifth to a
+// third of a 3D step), and holds the target's query index: one conversion, one nesting test and
+// one Embree scene of S2 serve the whole call, whichever way round diffusion runs.
 #include <morphomap/laplace3d.hpp>
 #include <morphomap/surface_queries.hpp>
 
+#include "diffusion/shell_mesh.hpp"
+
 namespace morphomap::detail {
 
-// As the public solve_diffusion_3d; `target_index`, when given, must index exactly
-// (target_vertices, target_faces); null: built here, after the surfaces are checked.
-ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, const FacesRef& source_faces,
-                                          const Points3Ref& target_vertices, const FacesRef& target_faces,
-                                          const ShellDiffusionOptions& options, const SurfaceIndex* target_index);
+// A source and a target that passed check_closed_surface with outward faces, as the arrays and
+// as their CGAL forms, with their signed volumes, their nesting (classify_nesting(source,
+// target), not disjoint) and the target's index (of exactly these arrays).
+struct ShellPair {
+  Points3Ref source_vertices;
+  FacesRef source_faces;
+  Points3Ref target_vertices;
+  FacesRef target_faces;
+  const ClosedSurface& source;
+  const ClosedSurface& target;
+  double source_volume;
+  double target_volume;
+  Nesting nesting;
+  const SurfaceIndex& target_index;
+};
+
+// As the public solve_diffusion_3d on a pair checked as above, with options the caller checked.
+ShellDiffusionSolution solve_diffusion_3d(const ShellPair& pair, const ShellDiffusionOptions& options);
 
 }  // namespace morphomap::detail

@@ -167,24 +167,19 @@ ClosedSurface::ClosedSurface(const Points3Ref& vertices, const FacesRef& faces)
     : mesh_(std::make_unique<Mesh>(Mesh{to_surface_mesh(vertices, faces)})) {}
 ClosedSurface::~ClosedSurface() = default;
 
-Nesting classify_nesting(const Points3Ref& source_vertices, const FacesRef& source_faces,
-                         const Points3Ref& target_vertices, const FacesRef& target_faces) {
-  const ClosedSurface source(source_vertices, source_faces);
-  const ClosedSurface target(target_vertices, target_faces);
-  return classify_nesting(source, target);
-}
-
 Nesting classify_nesting(const ClosedSurface& source_surface, const ClosedSurface& target_surface) {
   try {
     const SurfaceMesh& source = source_surface.mesh().surface;
     const SurfaceMesh& target = target_surface.mesh().surface;
     // Mesh_3 on a self-intersecting surface may crash rather than fail.
-    if (CGAL::Polygon_mesh_processing::does_self_intersect(source)) {
+    if (!source_surface.known_simple() && CGAL::Polygon_mesh_processing::does_self_intersect(source)) {
       throw InvalidInput(std::string("s1: ") + kSelfIntersecting);
     }
-    if (CGAL::Polygon_mesh_processing::does_self_intersect(target)) {
+    source_surface.mark_simple();
+    if (!target_surface.known_simple() && CGAL::Polygon_mesh_processing::does_self_intersect(target)) {
       throw InvalidInput(std::string("s2: ") + kSelfIntersecting);
     }
+    target_surface.mark_simple();
     if (CGAL::Polygon_mesh_processing::do_intersect(source, target)) return Nesting::crossing;
     const CGAL::Side_of_triangle_mesh<SurfaceMesh, Kernel> in_target(target), in_source(source);
     const Point s = source.point(*source.vertices().begin());

@@ -3,6 +3,7 @@
 // stable: the translation unit behind it compiles for minutes.
 #include <morphomap/types.hpp>
 
+#include <atomic>
 #include <memory>
 #include <vector>
 
@@ -21,17 +22,26 @@ class ClosedSurface {
   struct Mesh;  // the CGAL surface mesh (shell_mesh.cpp)
   const Mesh& mesh() const { return *mesh_; }
 
+  // Whether classify_nesting has found it free of self-intersections: a surface held for several
+  // pairs (PreparedSurface, a series' frame) is tested once, not once per pair and stage.
+  bool known_simple() const { return known_simple_.load(std::memory_order_relaxed); }
+  void mark_simple() const { known_simple_.store(true, std::memory_order_relaxed); }
+
  private:
   std::unique_ptr<Mesh> mesh_;
+  mutable std::atomic<bool> known_simple_{false};  // set once; a race only repeats the test
 };
 
 // How two closed, outward-oriented surfaces lie relative to each other. Throws InvalidInput if
-// either intersects itself.
+// either intersects itself (a surface already known_simple is not tested again).
 enum class Nesting { source_inside, target_inside, disjoint, crossing };
 Nesting classify_nesting(const ClosedSurface& source, const ClosedSurface& target);
-// The same from the arrays (for a caller that has no other use for the conversion).
-Nesting classify_nesting(const Points3Ref& source_vertices, const FacesRef& source_faces,
-                         const Points3Ref& target_vertices, const FacesRef& target_faces);
+// The nesting of the pair taken the other way round (target as source).
+inline Nesting swapped(Nesting nesting) {
+  if (nesting == Nesting::source_inside) return Nesting::target_inside;
+  if (nesting == Nesting::target_inside) return Nesting::source_inside;
+  return nesting;
+}
 
 // For each query point: whether it lies inside the closed, outward-oriented surface (exact
 // predicates, so points within rounding of the surface are still told apart); on it counts as inside.

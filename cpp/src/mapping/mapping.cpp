@@ -19,6 +19,7 @@
 #include "curves/inside.hpp"
 #include "curves/unchecked.hpp"
 #include "diffusion/laplace_unchecked.hpp"
+#include "mapping/optimal_unchecked.hpp"
 
 #include <unsupported/Eigen/FFT>
 
@@ -218,7 +219,9 @@ double refined_anchor(const ArcCurve& source, const ArcCurve& target, double anc
 // half way round and where the first matching took it, and matched again, so that the pinned
 // point of the first pass is free in the second; the lower energy wins.
 Points2 optimal_ends(const Job& job, double stretch_weight) {
-  if (!job.source_closed) return monotone_match(job.source, job.start_rows, job.target, stretch_weight).points;
+  if (!job.source_closed) {
+    return detail::monotone_match_unchecked(job.source, job.start_rows, job.target, stretch_weight).points;
+  }
   const ArcCurve source = ArcCurve::unchecked(job.source, true);
   const ArcCurve given = ArcCurve::unchecked(job.target, true);
   const ArcCurve target = ArcCurve::unchecked(
@@ -231,7 +234,7 @@ Points2 optimal_ends(const Job& job, double stretch_weight) {
     for (Index j = 0; j <= n; ++j) rotated.row(j) = source.points().row((h + j) % n);
     std::vector<Index> rows(count);
     for (Index k = 0; k < count; ++k) rows[k] = (job.start_rows[(first + k) % count] - h + n) % n;
-    match = monotone_match(rotated, rows, cut_open(target, anchor), stretch_weight);
+    match = detail::monotone_match_unchecked(rotated, rows, cut_open(target, anchor), stretch_weight);
     Points2 ends(count, 2);
     for (Index k = 0; k < count; ++k) ends.row((first + k) % count) = match.points.row(k);
     return ends;

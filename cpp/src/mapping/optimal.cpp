@@ -8,7 +8,9 @@
 #include "common/numbers.hpp"
 #include "common/validation.hpp"
 #include "curves/arc_curve.hpp"
+#include "curves/unchecked.hpp"
 #include "mapping/match_region.hpp"
+#include "mapping/optimal_unchecked.hpp"
 
 #include <morphomap/errors.hpp>
 
@@ -314,12 +316,17 @@ MonotoneMatch monotone_match(const Points2Ref& source, const std::vector<Index>&
   if (target.rows() < 2) detail::invalid("target", "needs at least 2 points");
   if (!source.allFinite()) detail::invalid("source", "has a non-finite coordinate");
   if (!target.allFinite()) detail::invalid("target", "has a non-finite coordinate");
-  const Index n = static_cast<Index>(start_rows.size());
-  for (Index r = 0; r < n; ++r) {
+  for (std::size_t r = 0; r < start_rows.size(); ++r) {
     if (start_rows[r] < 0 || start_rows[r] >= source.rows() || (r > 0 && start_rows[r] <= start_rows[r - 1])) {
       detail::invalid("start_rows", "must be increasing rows of source");
     }
   }
+  return detail::monotone_match_unchecked(source, start_rows, target, stretch_weight);
+}
+
+MonotoneMatch detail::monotone_match_unchecked(const Points2Ref& source, const std::vector<Index>& start_rows,
+                                               const Points2Ref& target, double stretch_weight) {
+  const Index n = static_cast<Index>(start_rows.size());
   MonotoneMatch match;
   match.arcs.resize(n);
   match.points.resize(n, 2);
@@ -337,7 +344,8 @@ MonotoneMatch monotone_match(const Points2Ref& source, const std::vector<Index>&
     match.points = target.row(0).replicate(n, 1);
     return match;
   }
-  const ArcCurve curve(target, false, "target");
+  // Finite, 2 points or more (checked by the caller) and of non-zero length: the unchecked forms.
+  const ArcCurve curve = ArcCurve::unchecked(target, false);
 
   Problem p;
   p.starts = source(start_rows, Eigen::all);
@@ -351,7 +359,9 @@ MonotoneMatch monotone_match(const Points2Ref& source, const std::vector<Index>&
   p.stretch_weight = stretch_weight;
   p.alpha = p.source_length > 0.0 ? p.target_length / p.source_length : 1.0;
   p.target = &curve;
-  const double gap2 = CurveIndex(target, false).closest_points(p.starts).distances.array().square().mean();
+  using Unchecked = detail::CurveIndexUnchecked;
+  const double gap2 =
+      Unchecked::closest_points(Unchecked::build(target, false), p.starts).distances.array().square().mean();
   const double spacing = p.source_length / static_cast<double>(n + 1);
   const double scale = std::max({gap2, spacing * spacing, 1e-300});
   p.displacement_weight = 1.0 / scale;

@@ -22,10 +22,21 @@ namespace morphomap {
 
 namespace {
 
+// A surface checked at the entry (closed, outward), with what the entry knows of it.
 struct Surface {
   Points3Ref vertices;
   FacesRef faces;
-  const SurfaceIndex* index = nullptr;  // its query index where the caller has one (PreparedSurface)
+  double volume;                                  // positive
+  const SurfaceIndex* index = nullptr;            // its query index where the caller has one (PreparedSurface)
+  const detail::ClosedSurface* closed = nullptr;  // its CGAL form (set by `checked`)
+};
+
+// The two surfaces of one call and their nesting (classify_nesting(source, target)), each way
+// round: diffusion reuses the entry's conversion and nesting test.
+struct Pair {
+  Surface source, target;
+  detail::Nesting nesting;
+  Pair swapped() const { return Pair{target, source, detail::swapped(nesting)}; }
 };
 
 // `surface`'s own index, else one built into `built`.
@@ -35,12 +46,14 @@ const SurfaceIndex& index_of(const Surface& surface, std::unique_ptr<SurfaceInde
   return *built;
 }
 
-// Vectors from the vertices of `source` to `target` (queried through `target_index`, built from
-// it) with one basic algorithm; diffusion with `diffusion`'s options. Diffusion's fold repair also
-// queries `source`: through `source_index` where the caller has one, else through one built here.
-DisplacementField3 basic(MapMethod method, const Surface& source, const Surface& target,
-                         const SurfaceIndex& target_index, const ShellDiffusionOptions& diffusion,
-                         const SurfaceIndex* source_index = nullptr) {
+// Vectors from the vertices of `pair.source` to `pair.target` (queried through `target_index`,
+// built from it) with one basic algorithm; diffusion with `diffusion`'s options. Diffusion's fold
+// repair also queries the source: through `source_index` where the caller has one, else through
+// one built here.
+DisplacementField3 basic(MapMethod method, const Pair& pair, const SurfaceIndex& target_index,
+                         const ShellDiffusionOptions& diffusion, const SurfaceIndex* source_index = nullptr) {
+  const Surface& source = pair.source;
+  const Surface& target = pair.target;
   DisplacementField3 field;
   field.starts = source.vertices;
   field.faces = source.faces;
@@ -56,8 +69,10 @@ DisplacementField3 basic(MapMethod method, const Surface& source, const Surface&
       break;
     }
     case MapMethod::diffusion: {
-      const ShellDiffusionSolution solution = detail::solve_diffusion_3d(source.vertices, source.faces, target.vertices,
-                                                                         target.faces, diffusion, &target_index);
+      const ShellDiffusionSolution solution = detail::solve_diffusion_3d(
+          detail::ShellPair{source.vertices, source.faces, target.vertices, target.faces, *source.closed,
+                            *target.closed, source.volume, target.volume, pair.nesting, target_index},
+          diffusion);
       if (solution.ends.rows() != field.size())
         throw GeometryError("diffusion: the solver returned the wrong number of ends");
       field.ends = solution.ends;  // on the target itself (solve_diffusion_3d puts them there)
@@ -106,10 +121,12 @@ bool complete(const DisplacementField3& field) {
 // (the paper's choice), else diffusion (both fold-free by construction), else the normal mapping
 // if it missed nothing, else minimal distance (which always finds a point): it answers wherever a
 // basic algorithm does.
-DisplacementField3 automatic(const Surface& source, const Surface& target, const SurfaceIndex& target_index,
+DisplacementField3 automatic(const Pair& pair, const SurfaceIndex& target_index,
                              const ShellDiffusionOptions& diffusion) {
+  const Surface& source = pair.source;
+  const Surface& target = pair.target;
   if (diffusion.on_stage) diffusion.on_stage("normal");
-  DisplacementField3 normal = basic(MapMethod::normal, source, target, target_index, diffusion);
+  DisplacementField3 normal = basic(MapMethod::normal, pair, target_index, diffusion);
   std::unique_ptr<SurfaceIndex> built;
   const SurfaceIndex& source_index = index_of(source, built);
   const bool missed = !complete(normal);
@@ -120,30 +137,41 @@ DisplacementField3 automatic(const Surface& source, const Surface& target, const
   for (const bool backwards : {true, false}) {
     try {
       DisplacementField3 field =
-          backwards ? flipped(basic(MapMethod::diffusion, target, source, source_index, diffusion, &target_index))
-                    : basic(MapMethod::diffusion, source, target, target_index, diffusion, &source_index);
+          backwards ? flipped(basic(MapMethod::diffusion, pair.swapped(), source_index, diffusion, &target_index))
+                    : basic(MapMethod::diffusion, pair, target_index, diffusion, &source_index);
       if (complete(field)) return field;
     } catch (const GeometryError&) {
     } catch (const InvalidInput&) {  // surfaces whose region diffusion cannot mesh (they coincide in part, say)
     }
   }
   if (!missed) return normal;
-  return basic(MapMethod::minimal_distance, source, target, target_index, diffusion);
+  return basic(MapMethod::minimal_distance, pair, target_index, diffusion);
 }
 
-DisplacementField3 directed(MapMethod method, const Surface& source, const Surface& target,
-                            const ShellDiffusionOptions& diffusion) {
+DisplacementField3 directed(MapMethod method, const Pair& pair, const ShellDiffusionOptions& diffusion) {
   std::unique_ptr<SurfaceIndex> built;
-  const SurfaceIndex& target_index = index_of(target, built);
-  if (method == MapMethod::automatic) return automatic(source, target, target_index, diffusion);
-  return basic(method, source, target, target_index, diffusion, source.index);
+  const SurfaceIndex& target_index = index_of(pair.target, built);
+  if (method == MapMethod::automatic) return automatic(pair, target_index, diffusion);
+  return basic(method, pair, target_index, diffusion, pair.source.index);
 }
 
-// map_surfaces on two checked surfaces.
-DisplacementField3 checked(const Surface& s1, const Surface& s2, const SurfaceMappingOptions& options) {
+// `surface`'s CGAL form: its own (PreparedSurface), else one converted into `built`.
+const detail::ClosedSurface& closed_of(const Surface& surface, std::unique_ptr<const detail::ClosedSurface>& built) {
+  if (surface.closed != nullptr) return *surface.closed;
+  built = std::make_unique<const detail::ClosedSurface>(surface.vertices, surface.faces);
+  return *built;
+}
+
+// map_surfaces on two checked surfaces: each converted to CGAL's form and tested for
+// self-intersections once, here, for every algorithm and direction the call runs.
+DisplacementField3 checked(Surface s1, Surface s2, const SurfaceMappingOptions& options) {
+  std::unique_ptr<const detail::ClosedSurface> built1, built2;
+  s1.closed = &closed_of(s1, built1);
+  s2.closed = &closed_of(s2, built2);
   // Both surfaces free of self-intersections (classify_nesting checks), and overlapping: frames
   // of one organ do (see map_curves).
-  if (detail::classify_nesting(s1.vertices, s1.faces, s2.vertices, s2.faces) == detail::Nesting::disjoint) {
+  const detail::Nesting nesting = detail::classify_nesting(*s1.closed, *s2.closed);
+  if (nesting == detail::Nesting::disjoint) {
     detail::invalid("s2",
                     "lies apart from s1 (the surfaces neither cross nor enclose one another): consecutive "
                     "frames of one organ overlap; check their units and offsets");
@@ -158,23 +186,26 @@ DisplacementField3 checked(const Surface& s1, const Surface& s2, const SurfaceMa
   ShellDiffusionOptions diffusion;
   diffusion.mesh_size = options.diffusion_mesh_size;
   diffusion.on_stage = options.on_stage;
-  if (!options.reverse) return directed(options.method, s1, s2, diffusion);
-  return flipped(directed(options.method, s2, s1, diffusion));
+  const Pair pair{s1, s2, nesting};
+  if (!options.reverse) return directed(options.method, pair, diffusion);
+  return flipped(directed(options.method, pair.swapped(), diffusion));
 }
 
 }  // namespace
 
 DisplacementField3 map_surfaces(const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2,
                                 const SurfaceMappingOptions& options) {
-  detail::require_outward(check_closed_surface(v1, f1, "s1"), "s1");
-  detail::require_outward(check_closed_surface(v2, f2, "s2"), "s2");
-  return checked(Surface{v1, f1}, Surface{v2, f2}, options);
+  const double volume1 = check_closed_surface(v1, f1, "s1");
+  detail::require_outward(volume1, "s1");
+  const double volume2 = check_closed_surface(v2, f2, "s2");
+  detail::require_outward(volume2, "s2");
+  return checked(Surface{v1, f1, volume1}, Surface{v2, f2, volume2}, options);
 }
 
 DisplacementField3 map_surfaces(const PreparedSurface& s1, const PreparedSurface& s2,
                                 const SurfaceMappingOptions& options) {
-  return checked(Surface{s1.vertices(), s1.faces(), &s1.index()}, Surface{s2.vertices(), s2.faces(), &s2.index()},
-                 options);
+  return checked(Surface{s1.vertices(), s1.faces(), s1.volume(), &s1.index(), &s1.closed()},
+                 Surface{s2.vertices(), s2.faces(), s2.volume(), &s2.index(), &s2.closed()}, options);
 }
 
 }  // namespace morphomap
