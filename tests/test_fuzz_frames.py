@@ -40,7 +40,8 @@ Environment (all optional):
 - ``MORPHOMAP_FUZZ_SEEDS``: exactly these seeds, e.g. ``"2d:17,203;3d:5"`` (no fixed or fresh ones).
 - ``MORPHOMAP_FUZZ_TIMEOUT_2D`` (60) / ``MORPHOMAP_FUZZ_TIMEOUT_3D`` (120): seconds per case.
 - ``MORPHOMAP_FUZZ_EXTRA_EVERY`` (20; 0: never).
-- ``MORPHOMAP_FUZZ_WORKERS`` (1): child processes at a time.
+- ``MORPHOMAP_FUZZ_WORKERS`` (the usable cores, at most 2): child processes at a time. Each
+  case still runs alone in a child, so a crash or a hang names its seed whatever the number.
 - ``MORPHOMAP_FUZZ_REPORT``: a path; every case's record is appended there as a JSON line as
   soon as it is known.
 
@@ -92,7 +93,17 @@ FRESH_2D = min(_env_int("MORPHOMAP_FUZZ_FRESH", 4), PAIRS_2D)
 FRESH_3D = min(_env_int("MORPHOMAP_FUZZ_FRESH_3D", 2), PAIRS_3D)
 TIMEOUT = {2: _env_float("MORPHOMAP_FUZZ_TIMEOUT_2D", 60.0), 3: _env_float("MORPHOMAP_FUZZ_TIMEOUT_3D", 120.0)}
 EXTRA_EVERY = _env_int("MORPHOMAP_FUZZ_EXTRA_EVERY", 20)
-WORKERS = max(1, _env_int("MORPHOMAP_FUZZ_WORKERS", 1))
+def _usable_cores():
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+# Two children by default: the cases are independent and most of a case's time is one thread
+# (2D meshing and tracing, the Python checks), so a second child nearly halves the suite on CI's
+# two cores (bench/README, "CI time"); more would multiply the 3D meshes' memory.
+WORKERS = max(1, _env_int("MORPHOMAP_FUZZ_WORKERS", min(2, _usable_cores())))
 STARTUP_TIMEOUT = 300.0
 REPORT = os.environ.get("MORPHOMAP_FUZZ_REPORT", "").strip()
 
@@ -284,6 +295,17 @@ def _fatal_lines(tail):
     return " | ".join(lines[-4:])
 
 
+def _share_tail(idle, others):
+    """Moves the back half of the longest other queue to the idle child's queue. Cases of one seed
+    go to one child (the frames are made once per child and seed); at the end of a run that left
+    one child with a whole 3D seed (8 cases, minutes) while the other had nothing to do."""
+    longest = max(others, key=len, default=None)
+    if longest is None or len(longest) < 2:
+        return
+    moved = [longest.pop() for _ in range(len(longest) // 2)]
+    idle.extend(reversed(moved))
+
+
 def run_cases(cases):
     """Run every case in worker children; returns one record per case, in order."""
     groups = collections.OrderedDict()
@@ -312,6 +334,8 @@ def run_cases(cases):
     def dispatch(child):
         nonlocal startup_failures
         queue = queues[id(child)]
+        if not queue and not pending:
+            _share_tail(queue, [queues[id(other)] for other in children if other is not child])
         while queue or pending:
             if not queue:
                 queue.extend(pending.popleft())
