@@ -79,6 +79,8 @@ def test_contact_tolerance_is_checked_and_zero_means_exact_contact():
     assert exact.valid.all() and mm.quality(exact, c1, c2).crossings == 0
     with pytest.raises(ValueError, match="contact_tolerance"):
         mm.map_curves(c1, c2, contact_tolerance=-1.0)
+    with pytest.raises(ValueError, match="^contact_tolerance: must be finite"):  # the core's rule
+        mm.map_curves(c1, c2, contact_tolerance=float("nan"))
     with pytest.raises(TypeError, match="contact_tolerance"):
         mm.map_curves(c1, c2, contact_tolerance="small")
 

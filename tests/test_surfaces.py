@@ -462,6 +462,31 @@ def test_open_flipped_nan_and_out_of_range(sphere):
         mm.map_surfaces((zero, f), good)
 
 
+@pytest.mark.parametrize("entry", ["map_surfaces", "quality", "solve_diffusion_3d", "PreparedSurface"])
+def test_every_surface_entry_names_bad_arrays_alike(sphere, entry):
+    # Finite vertices and face indices in range are the core's rules (check_closed_surface), checked
+    # once on the way; every entry that takes a closed surface names the array the same way.
+    v, f = sphere
+    bad = v.copy()
+    bad[7, 2] = np.inf
+    out = f.copy()
+    out[3, 1] = len(v) + 5
+    field = mm.map_surfaces((v, f), (1.5 * v, f))
+    entries = {
+        "map_surfaces": lambda s: mm.map_surfaces((v, f), s),
+        "quality": lambda s: mm.quality(field, (v, f), s),
+        "solve_diffusion_3d": lambda s: mm.solve_diffusion_3d((v, f), s),
+        "PreparedSurface": lambda s: mm.PreparedSurface(s, "s2"),
+    }
+    call = entries[entry]
+    with pytest.raises(ValueError, match=r"^s2 vertices: row 7 has a non-finite coordinate"):
+        call((bad, f))
+    with pytest.raises(ValueError, match=rf"^s2 faces: vertex index {len(v) + 5} is outside 0\.\.{len(v) - 1}"):
+        call((v, out))
+    with pytest.raises(ValueError, match=r"^s2 faces: vertex index -1 "):
+        call((v, f - 1))
+
+
 def test_wrong_types_and_shapes(sphere):
     v, f = sphere
     good = (v, f)

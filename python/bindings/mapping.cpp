@@ -13,6 +13,7 @@
 
 #include "interrupt_guard.hpp"
 
+#include <iterator>
 #include <memory>
 #include <string>
 
@@ -21,23 +22,12 @@ using namespace morphomap;
 
 namespace {
 
-MapMethod map_method(const std::string& name) {
-  if (name == "minimal_distance") return MapMethod::minimal_distance;
-  if (name == "normal") return MapMethod::normal;
-  if (name == "diffusion") return MapMethod::diffusion;
-  if (name == "uniform") return MapMethod::uniform;
-  if (name == "auto") return MapMethod::automatic;
-  if (name == "optimal") return MapMethod::optimal;
-  throw InvalidInput(
-      "method: expected 'auto', 'minimal_distance', 'normal', 'diffusion', 'uniform' or 'optimal', got '" + name + "'");
-}
-
 CurveMappingOptions curve_mapping_options(const std::string& method, bool closed, Index n, bool reverse, bool transform,
                                           bool split, std::optional<Vec2> anchor, double density_threshold,
                                           double contact_tolerance, double mesh_size, double mesh_fraction,
                                           double stretch_weight) {
   CurveMappingOptions options;
-  options.method = map_method(method);
+  options.method = map_method_named(method);
   options.closed = closed;
   options.n = n;
   options.reverse = reverse;
@@ -99,6 +89,13 @@ void bind_mapping(py::module_& m) {
       py::arg("closed"), py::arg("n"), py::arg("anchor"), py::arg("density_threshold"), py::arg("contact_tolerance"),
       py::arg("mesh_size"), py::arg("mesh_fraction"), py::arg("stretch_weight"));
   m.attr("DEFAULT_STRETCH_WEIGHT") = kDefaultStretchWeight;
+  // The core's registry of names: what map_curves takes, and what a field's methods can say.
+  py::tuple map_methods(std::size(kMapMethods));
+  for (std::size_t i = 0; i < std::size(kMapMethods); ++i) map_methods[i] = map_method_name(kMapMethods[i]);
+  m.attr("MAP_METHODS") = map_methods;
+  py::tuple method_names(kMethodCount);
+  for (int code = 0; code < kMethodCount; ++code) method_names[code] = method_name(static_cast<Method>(code));
+  m.attr("METHOD_NAMES") = method_names;
 
   py::class_<CurvePiece>(m, "CurvePiece")
       .def_readonly("source", &CurvePiece::source)

@@ -15,6 +15,7 @@
 #include "interrupt_guard.hpp"
 #include "stage_callback.hpp"
 
+#include <iterator>
 #include <memory>
 #include <string>
 
@@ -26,14 +27,6 @@ namespace {
 
 using Release = py::call_guard<py::gil_scoped_release>;
 
-MapMethod surface_method(const std::string& name) {
-  if (name == "minimal_distance") return MapMethod::minimal_distance;
-  if (name == "normal") return MapMethod::normal;
-  if (name == "diffusion") return MapMethod::diffusion;
-  if (name == "auto") return MapMethod::automatic;
-  throw InvalidInput("method: expected 'minimal_distance', 'normal', 'diffusion' or 'auto', got '" + name + "'");
-}
-
 py::dict hits_record(SurfaceHits&& h) {
   return py::dict("points"_a = std::move(h.points), "distances"_a = std::move(h.distances),
                   "faces"_a = std::move(h.faces));
@@ -42,6 +35,9 @@ py::dict hits_record(SurfaceHits&& h) {
 }  // namespace
 
 void bind_surfaces(py::module_& m) {
+  py::tuple surface_methods(std::size(kSurfaceMethods));  // the core's registry (map_method_name)
+  for (std::size_t i = 0; i < std::size(kSurfaceMethods); ++i) surface_methods[i] = map_method_name(kSurfaceMethods[i]);
+  m.attr("SURFACE_METHODS") = surface_methods;
   py::class_<SurfaceIndex>(m, "SurfaceIndex")
       .def(py::init<const Points3Ref&, const FacesRef&>(), py::arg("vertices"), py::arg("faces"), Release())
       .def(
@@ -88,7 +84,7 @@ void bind_surfaces(py::module_& m) {
       [](const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2, const std::string& method,
          bool reverse, double mesh_size, const py::object& on_stage) {
         SurfaceMappingOptions options;
-        options.method = surface_method(method);
+        options.method = map_method_named(method);
         options.reverse = reverse;
         options.diffusion_mesh_size = mesh_size;
         options.on_stage = stage_callback(on_stage);
@@ -108,7 +104,7 @@ void bind_surfaces(py::module_& m) {
       [](const PreparedSurface& s1, const PreparedSurface& s2, const std::string& method, bool reverse,
          double mesh_size, const py::object& on_stage) {
         SurfaceMappingOptions options;
-        options.method = surface_method(method);
+        options.method = map_method_named(method);
         options.reverse = reverse;
         options.diffusion_mesh_size = mesh_size;
         options.on_stage = stage_callback(on_stage);

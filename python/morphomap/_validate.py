@@ -105,8 +105,9 @@ def as_length(value, name: str, default: float, *, allow_zero: bool = False) -> 
     return value
 
 
-def as_faces(value, name: str, vertex_count: int) -> np.ndarray:
-    """Return ``value`` as a C-contiguous int64 (F, 3) array of indices into ``vertex_count`` vertices."""
+def as_faces(value, name: str, vertex_count: int | None) -> np.ndarray:
+    """Return ``value`` as a C-contiguous int64 (F, 3) array of indices into ``vertex_count`` vertices
+    (None: the range is the core's check, as for closed surfaces)."""
     if isinstance(value, (str, bytes)) or value is None:
         raise TypeError(f"{name}: expected an integer array of shape (F, 3), got {type(value).__name__}")
     try:
@@ -120,7 +121,7 @@ def as_faces(value, name: str, vertex_count: int) -> np.ndarray:
             raise TypeError(f"{name}: expected integer vertex indices, got an array of dtype {array.dtype}")
     if array.ndim != 2 or array.shape[1] != 3:
         raise ValueError(f"{name}: expected shape (F, 3), got {array.shape}")
-    if array.size:
+    if array.size and vertex_count is not None:
         low, high = array.min(), array.max()
         if low < 0 or high >= vertex_count:
             bad = low if low < 0 else high

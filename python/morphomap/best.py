@@ -50,7 +50,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ._validate import as_count, as_flag, as_length, as_points
+from ._validate import as_count, as_flag, as_points
 
 #: Default of ``skip_below``: see the module's documentation.
 SKIP_BELOW = 1e-3
@@ -256,7 +256,7 @@ def map_best(c1, c2, *, closed=True, n=None, split=True, anchor=None, density_th
              skip_below=None, workers=None):
     """2D ``method="best"``: see the module's documentation. Called by :func:`map_curves`."""
     from . import _core
-    from .mapping import map_curves
+    from .mapping import as_contact_tolerance, map_curves
     from .quality import quality
 
     options = dict(closed=closed, n=n, split=split, anchor=anchor, contact_tolerance=contact_tolerance,
@@ -279,7 +279,7 @@ def map_best(c1, c2, *, closed=True, n=None, split=True, anchor=None, density_th
         return _pick(results, ())
     c1, c2 = as_points(c1, "c1"), as_points(c2, "c2")
     split_at = _core.split_curves(c1, c2, closed, as_flag(split, "split"),
-                                  as_length(contact_tolerance, "contact_tolerance", -1.0, allow_zero=True))
+                                  as_contact_tolerance(contact_tolerance))
     if len(split_at.pieces) < 2:
         return _pick(results, ())
     assembled, piece_rows = _per_piece(results, split_at, c1, c2, closed)

@@ -79,8 +79,8 @@ def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False, progress=No
         potential and ends, bit for bit, in any process and with any number of threads (the
         mesher runs on one core with fixed random choices).
     """
-    v1, f1 = as_surface(s1, "s1")
-    v2, f2 = as_surface(s2, "s2")
+    v1, f1 = as_surface(s1, "s1", core_checks=True)
+    v2, f2 = as_surface(s2, "s2", core_checks=True)
     size, keep = as_real(mesh_size, "mesh_size", 0.0), as_flag(streamlines, "streamlines")
     bar = StageBar(progress, "solve_diffusion_3d", DIFFUSION_STAGES)
     try:

@@ -4,14 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import _core
 from ._validate import as_faces, as_flag, as_points
 
-#: Names of the basic algorithms; ``reverse_`` ones ran from C2 to C1 and were flipped.
-BASIC_METHODS = ("minimal_distance", "normal", "diffusion", "uniform")
-#: In the core's code order (files store the codes): the paper's four, their reverse forms, then
-#: the order-preserving ``"optimal"`` matching (beyond the paper) and its reverse.
-METHOD_NAMES = (BASIC_METHODS + tuple(f"reverse_{name}" for name in BASIC_METHODS)
-                + ("optimal", "reverse_optimal"))
+#: The names a field's methods can take, in the core's code order (files store the codes): the
+#: paper's four, their ``reverse_`` forms (ran from C2 to C1 and flipped), then the order-preserving
+#: ``"optimal"`` matching (beyond the paper) and its reverse. The core's registry (``method_name``).
+METHOD_NAMES = tuple(_core.METHOD_NAMES)
 
 
 def _frozen(array: np.ndarray) -> np.ndarray:

@@ -5,22 +5,34 @@ from __future__ import annotations
 import numpy as np
 
 from . import _core
-from ._validate import as_choice, as_flag, as_integer, as_length, as_point, as_points, as_real
+from ._validate import as_choice, as_flag, as_integer, as_point, as_points, as_real
 from .field import DisplacementField
 
-CURVE_METHODS = ("auto", "minimal_distance", "normal", "diffusion", "uniform", "optimal", "best")
+#: What ``method`` takes: the core's registry (``kMapMethods``), then ``"best"``, which is Python's.
+CURVE_METHODS = tuple(_core.MAP_METHODS) + ("best",)
+
+
+def as_contact_tolerance(value) -> float:
+    """``contact_tolerance`` as the core takes it: None is the core's default (any negative
+    number there); a negative number passed here is refused rather than read as the default, the
+    one rule of Python's own. Finiteness is the core's rule."""
+    if value is None:
+        return -1.0
+    value = as_real(value, "contact_tolerance", 0.0)
+    if value < 0:
+        raise ValueError(f"contact_tolerance: must be a length >= 0 (None for the default), got {value}")
+    return value
 
 
 def _core_options(n, anchor, density_threshold, contact_tolerance, mesh_size, mesh_fraction, stretch_weight):
     """The options as the core takes them. Only their types are checked here: the core checks the
     values (``validate_options`` in ``morphomap/mapping.hpp``) and its messages are the ones users
-    see. The one rule of Python's own: ``contact_tolerance`` None is the core's default (any
-    negative number there), so a negative number passed here is refused rather than read as it."""
+    see; ``contact_tolerance`` has one rule of Python's own (:func:`as_contact_tolerance`)."""
     return dict(
         n=as_integer(n, "n", 0),
         anchor=None if anchor is None else as_point(anchor, "anchor", allow_nan=True),
         density_threshold=as_real(density_threshold, "density_threshold", 0.0),
-        contact_tolerance=as_length(contact_tolerance, "contact_tolerance", -1.0, allow_zero=True),
+        contact_tolerance=as_contact_tolerance(contact_tolerance),
         mesh_size=as_real(mesh_size, "mesh_size", 0.0),
         mesh_fraction=as_real(mesh_fraction, "mesh_fraction", 0.02),
         stretch_weight=as_real(stretch_weight, "stretch_weight", _core.DEFAULT_STRETCH_WEIGHT),

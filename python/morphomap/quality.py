@@ -127,8 +127,8 @@ def quality(field, c1, c2, *, closed=True):
         if isinstance(c1, PreparedSurface) and isinstance(c2, PreparedSurface):
             found = _core.prepared_surface_quality(field.starts, field.ends, faces, c1._prepared, c2._prepared)
         else:
-            v1, f1 = as_surface(c1, "s1")
-            v2, f2 = as_surface(c2, "s2")
+            v1, f1 = as_surface(c1, "s1", core_checks=True)
+            v2, f2 = as_surface(c2, "s2", core_checks=True)
             found = _core.surface_quality(field.starts, field.ends, faces, v1, f1, v2, f2)
         return SurfaceQuality(float(found["qm1"]), float(found["qm2"]), float(found["qm"]), int(found["folds"]))
     if field.dim != 2:

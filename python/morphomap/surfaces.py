@@ -11,22 +11,27 @@ from ._progress import StageBar, as_progress
 from ._validate import as_choice, as_faces, as_flag, as_points, as_real
 from .field import DisplacementField
 
-SURFACE_METHODS = ("minimal_distance", "normal", "diffusion", "auto", "best")
+#: What ``method`` takes: the core's registry (``kSurfaceMethods``), then ``"best"``, which is Python's.
+SURFACE_METHODS = tuple(_core.SURFACE_METHODS) + ("best",)
 # The stages the core reports (SurfaceMappingOptions::on_stage), in order, for the progress bar.
 DIFFUSION_STAGES = ("mesh", "solve", "trace")
 _STAGES = {"diffusion": DIFFUSION_STAGES, "auto": ("normal",) + DIFFUSION_STAGES}
 
 
-def as_surface(value, name: str) -> tuple[np.ndarray, np.ndarray]:
-    """Return ``(vertices, faces)`` of a ``trimesh.Trimesh`` or a ``(vertices, faces)`` pair."""
+def as_surface(value, name: str, *, core_checks: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Return ``(vertices, faces)`` of a ``trimesh.Trimesh`` or a ``(vertices, faces)`` pair.
+
+    ``core_checks``: the values go to the core's ``check_closed_surface``, which checks that the
+    vertices are finite and the face indices in range with the same messages; only types and
+    shapes are checked here. Otherwise they are checked here."""
     if hasattr(value, "vertices") and hasattr(value, "faces") and not isinstance(value, (tuple, list)):
         vertices, faces = value.vertices, value.faces
     elif isinstance(value, (tuple, list)) and len(value) == 2:
         vertices, faces = value
     else:
         raise TypeError(f"{name}: expected a trimesh.Trimesh or a (vertices, faces) pair, got {type(value).__name__}")
-    vertices = as_points(vertices, f"{name} vertices", 3)
-    return vertices, as_faces(faces, f"{name} faces", len(vertices))
+    vertices = as_points(vertices, f"{name} vertices", 3, allow_nan=core_checks)
+    return vertices, as_faces(faces, f"{name} faces", None if core_checks else len(vertices))
 
 
 class SurfaceHits(NamedTuple):
@@ -90,7 +95,7 @@ class PreparedSurface:
     Parameters
     ----------
     surface : trimesh.Trimesh or (vertices (V, 3) float, faces (F, 3) int)
-        Closed with outward faces, as :func:`map_surfaces` wants (checked here; copied).
+        Closed with outward faces, as :func:`map_surfaces` wants (checked here, by the core; copied).
     name : str
         How error messages name it.
     """
@@ -98,7 +103,8 @@ class PreparedSurface:
     def __init__(self, surface, name: str = "surface"):
         # Copies, read-only: the core holds its own, and a caller editing the mesh afterwards must not
         # leave the two sides of a mixed call on different surfaces.
-        self.vertices, self.faces = (np.array(array, copy=True) for array in as_surface(surface, name))
+        converted = as_surface(surface, name, core_checks=True)  # the core checks them (below)
+        self.vertices, self.faces = (np.array(array, copy=True) for array in converted)
         self.vertices.flags.writeable = self.faces.flags.writeable = False
         self._prepared = _core.PreparedSurface(self.vertices, self.faces, str(name))
 
@@ -180,8 +186,8 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None, skip
         raise ValueError("skip_below/workers: only for method 'best'")
     prepared = isinstance(s1, PreparedSurface) and isinstance(s2, PreparedSurface)
     if not prepared:
-        v1, f1 = as_surface(s1, "s1")
-        v2, f2 = as_surface(s2, "s2")
+        v1, f1 = as_surface(s1, "s1", core_checks=True)
+        v2, f2 = as_surface(s2, "s2", core_checks=True)
     size = as_real(mesh_size, "mesh_size", 0.0)
     bar = StageBar(progress, "map_surfaces", _STAGES.get(method, ()))
     try:

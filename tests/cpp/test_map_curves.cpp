@@ -170,6 +170,29 @@ bool same_number(double a, double b) { return a == b || (std::isnan(a) && std::i
 // map_curves and quality on prepared curves (checked and indexed once) against the plain calls:
 // the same fields and quality, bit for bit, over the methods and the options that change which
 // curves the mapping runs on (resampled, moved) and which indices it may reuse.
+// The registry: every MapMethod's name reads back as it; other names are refused with the list.
+void method_names_round_trip() {
+  for (const MapMethod method : morphomap::kMapMethods) {
+    CHECK(morphomap::map_method_named(morphomap::map_method_name(method)) == method);
+  }
+  CHECK(std::string(morphomap::map_method_name(MapMethod::automatic)) == "auto");
+  try {
+    (void)morphomap::map_method_named("automatic");
+    CHECK(false);
+  } catch (const InvalidInput& e) {
+    CHECK(std::string(e.what()) ==
+          "method: expected one of 'auto', 'minimal_distance', 'normal', 'diffusion', 'uniform' or 'optimal', got "
+          "'automatic'");
+  }
+  for (int code = 0; code < morphomap::kMethodCount; ++code) {
+    const Method method = static_cast<Method>(code);
+    const std::string name = morphomap::method_name(method);
+    CHECK(name != "unknown");
+    CHECK(morphomap::method_name(morphomap::reversed(method)) ==
+          (name.rfind("reverse_", 0) == 0 ? name.substr(8) : "reverse_" + name));
+  }
+}
+
 void prepared_curves_give_the_plain_results() {
   Points2 wavy = ellipse(300, 1.4, 0.9);  // crosses the circle four times (split)
   for (Index i = 0; i < wavy.rows(); ++i) wavy.row(i) *= 1.0 + 0.05 * std::sin(7 * 2 * pi * i / 300.0);
@@ -253,5 +276,6 @@ int main() {
   automatic_maps_concentric_circles_radially();
   bad_curves_are_named();
   prepared_curves_give_the_plain_results();
+  method_names_round_trip();
   TEST_MAIN_END();
 }

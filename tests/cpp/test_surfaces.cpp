@@ -104,6 +104,19 @@ int main() {
     } catch (const InvalidInput& e) {
       CHECK(std::string(e.what()).rfind("s2: ", 0) == 0);
     }
+    // The array rules name the array as Python's conversions do (the one check on the way).
+    try {
+      check_closed_surface(nan, sphere.faces, "s1");
+      CHECK(false);
+    } catch (const InvalidInput& e) {
+      CHECK(std::string(e.what()).rfind("s1 vertices: row 3 has a non-finite coordinate", 0) == 0);
+    }
+    try {
+      check_closed_surface(sphere.vertices, out, "s2");
+      CHECK(false);
+    } catch (const InvalidInput& e) {
+      CHECK(std::string(e.what()).rfind("s2 faces: vertex index " + std::to_string(sphere.vertices.rows()), 0) == 0);
+    }
   }
 
   // Vertex normals of the sphere point outwards along the radius.
@@ -303,7 +316,17 @@ int main() {
     }
   }
 
-  options.method = MapMethod::uniform;
-  CHECK_THROWS(map_surfaces(sphere.vertices, sphere.faces, ellipsoid.vertices, ellipsoid.faces, options), InvalidInput);
+  // Only kSurfaceMethods have a 3D form; the refusal names the method and lists them.
+  for (const MapMethod method : {MapMethod::uniform, MapMethod::optimal}) {
+    options.method = method;
+    try {
+      (void)map_surfaces(sphere.vertices, sphere.faces, ellipsoid.vertices, ellipsoid.faces, options);
+      CHECK(false);
+    } catch (const InvalidInput& e) {
+      CHECK(std::string(e.what()) == std::string("method: ") + map_method_name(method) +
+                                         " mapping has no 3D form; use 'auto', 'minimal_distance', 'normal' or "
+                                         "'diffusion'");
+    }
+  }
   TEST_MAIN_END();
 }

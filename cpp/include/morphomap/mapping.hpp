@@ -7,11 +7,26 @@
 #include <morphomap/types.hpp>
 
 #include <optional>
+#include <string>
 #include <vector>
 
 namespace morphomap {
 
 enum class MapMethod { minimal_distance, normal, diffusion, uniform, automatic, optimal };
+
+// Every MapMethod, in the order users see them listed. Their names (map_method_name) are the one
+// registry that the core's messages, the Python bindings, the command line and the demo read.
+constexpr MapMethod kMapMethods[] = {MapMethod::automatic, MapMethod::minimal_distance, MapMethod::normal,
+                                     MapMethod::diffusion, MapMethod::uniform,          MapMethod::optimal};
+
+// "auto" for automatic, else the enumerator's name.
+const char* map_method_name(MapMethod method);
+
+// The MapMethod called `name`: InvalidInput naming "method" (and listing the names) otherwise.
+MapMethod map_method_named(const std::string& name);
+
+// The names of [first, last) in quotes: "'a', 'b' or 'c'" (for messages).
+std::string quoted_method_names(const MapMethod* first, const MapMethod* last);
 
 struct CurveMappingOptions {
   MapMethod method = MapMethod::automatic;  // the paper's Algorithm 1

@@ -10,6 +10,10 @@
 
 namespace morphomap {
 
+// The methods map_surfaces takes, in the order users see them listed.
+constexpr MapMethod kSurfaceMethods[] = {MapMethod::automatic, MapMethod::minimal_distance, MapMethod::normal,
+                                         MapMethod::diffusion};
+
 struct SurfaceMappingOptions {
   // minimal_distance: each vertex to its closest point on the target.
   // normal: the line through each vertex along its angle-weighted normal, both directions, to the
@@ -21,7 +25,7 @@ struct SurfaceMappingOptions {
   //   diffusion for the whole surface instead (methods tells which); where that fails (the
   //   region cannot be meshed), diffusion, then the normal mapping if it missed nothing, then
   //   minimal distance.
-  // uniform has no 3D form: InvalidInput.
+  // Only kSurfaceMethods: uniform and optimal have no 3D form (InvalidInput).
   MapMethod method = MapMethod::normal;
   bool reverse = false;              // map S2 -> S1 and flip: starts on S1, ends on S2, rows and faces of S2
   double diffusion_mesh_size = 0.0;  // ShellDiffusionOptions::mesh_size (0: automatic)

@@ -45,6 +45,7 @@ Points3 vertex_normals(const Points3Ref& vertices, const FacesRef& faces);
 // Throws InvalidInput naming `name` unless the surface is closed, edge-manifold and consistently
 // oriented, one connected component, with finite coordinates, valid indices, every vertex used and
 // no zero-area face; returns its signed volume (positive when the normals point outwards).
+// (A non-finite coordinate names "`name` vertices", an index out of range "`name` faces".)
 double check_closed_surface(const Points3Ref& vertices, const FacesRef& faces, const char* name);
 
 }  // namespace morphomap

@@ -160,6 +160,10 @@ Index require_simple_curve(const Points2Ref& points, bool closed, const char* na
   return n;
 }
 
+void require_contact_tolerance(double value) {
+  if (!std::isfinite(value)) invalid("contact_tolerance", "must be finite, got " + std::to_string(value));
+}
+
 void require_diffusion_options(const DiffusionOptions& options) {
   if (!(options.mesh_size >= 0.0) || !std::isfinite(options.mesh_size)) {
     invalid("mesh_size", "must be a finite length >= 0 (0: automatic)");

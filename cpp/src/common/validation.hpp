@@ -63,6 +63,9 @@ void require_no_self_intersection(const Points2Ref& points, bool closed, const c
 // Mapping and quality need that (an inward surface would fold every triangle).
 void require_outward(double volume, const char* name);
 
+// A contact tolerance (CurveMappingOptions::contact_tolerance) is finite; negative asks for the default.
+void require_contact_tolerance(double value);
+
 // A diffusion mesh size >= 0 and a mesh fraction > 0, both finite.
 void require_diffusion_options(const DiffusionOptions& options);
 

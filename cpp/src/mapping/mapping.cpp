@@ -39,32 +39,6 @@ using detail::kNaN;
 // go to the unchecked variants; the query points are points of those curves.
 using Unchecked = detail::CurveIndexUnchecked;
 
-std::string method_name(Method method) {
-  switch (method) {
-    case Method::minimal_distance:
-      return "minimal_distance";
-    case Method::normal:
-      return "normal";
-    case Method::diffusion:
-      return "diffusion";
-    case Method::uniform:
-      return "uniform";
-    case Method::reverse_minimal_distance:
-      return "reverse_minimal_distance";
-    case Method::reverse_normal:
-      return "reverse_normal";
-    case Method::reverse_diffusion:
-      return "reverse_diffusion";
-    case Method::reverse_uniform:
-      return "reverse_uniform";
-    case Method::optimal:
-      return "optimal";
-    case Method::reverse_optimal:
-      return "reverse_optimal";
-  }
-  return "unknown";
-}
-
 Method reversed(Method method) {
   switch (method) {
     case Method::optimal:
@@ -729,9 +703,7 @@ void validate_options(const CurveMappingOptions& options) {
   if (!(options.density_threshold >= 0.0) || !std::isfinite(options.density_threshold)) {
     detail::invalid("density_threshold", "must be a finite number >= 0 (0: off)");
   }
-  if (std::isnan(options.contact_tolerance) || std::isinf(options.contact_tolerance)) {
-    detail::invalid("contact_tolerance", "must be a finite length >= 0, or negative for the default");
-  }
+  detail::require_contact_tolerance(options.contact_tolerance);
   detail::require_diffusion_options(options.diffusion);
   if (options.anchor && !options.anchor->allFinite()) detail::invalid("anchor", "has a non-finite coordinate");
   if (!(options.stretch_weight >= 0.0) || !std::isfinite(options.stretch_weight)) {
@@ -836,9 +808,7 @@ DisplacementField2 map_curves(const PreparedCurve& c1, const PreparedCurve& c2, 
 CurveSplit split_curves(const Points2Ref& c1, const Points2Ref& c2, bool closed, bool split, double contact_tolerance) {
   const Index n1 = detail::require_simple_curve(c1, closed, "c1");
   const Index n2 = detail::require_simple_curve(c2, closed, "c2");
-  if (std::isnan(contact_tolerance) || std::isinf(contact_tolerance)) {
-    detail::invalid("contact_tolerance", "must be a finite length >= 0, or negative for the default");
-  }
+  detail::require_contact_tolerance(contact_tolerance);
   const ArcCurve source = ArcCurve::unchecked(c1.topRows(n1), closed);
   const ArcCurve target = ArcCurve::unchecked(c2.topRows(n2), closed);
   const int direction = closed ? relative_direction(source, target) : 1;

@@ -12,9 +12,12 @@
 
 #include <morphomap/errors.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <memory>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -94,9 +97,8 @@ DisplacementField3 basic(MapMethod method, const Pair& pair, const SurfaceIndex&
       }
       break;
     }
-    default:
-      detail::invalid("method",
-                      "uniform mapping has no 3D form; use 'minimal_distance', 'normal', 'diffusion' or 'auto'");
+    default:  // automatic is directed's; the others are refused at the entry (require_surface_method)
+      detail::invalid("method", std::string(map_method_name(method)) + " is not a basic 3D method");
   }
   return field;
 }
@@ -165,6 +167,10 @@ const detail::ClosedSurface& closed_of(const Surface& surface, std::unique_ptr<c
 // map_surfaces on two checked surfaces: each converted to CGAL's form and tested for
 // self-intersections once, here, for every algorithm and direction the call runs.
 DisplacementField3 checked(Surface s1, Surface s2, const SurfaceMappingOptions& options) {
+  if (std::find(std::begin(kSurfaceMethods), std::end(kSurfaceMethods), options.method) == std::end(kSurfaceMethods)) {
+    detail::invalid("method", std::string(map_method_name(options.method)) + " mapping has no 3D form; use " +
+                                  quoted_method_names(std::begin(kSurfaceMethods), std::end(kSurfaceMethods)));
+  }
   std::unique_ptr<const detail::ClosedSurface> built1, built2;
   s1.closed = &closed_of(s1, built1);
   s2.closed = &closed_of(s2, built2);
@@ -175,10 +181,6 @@ DisplacementField3 checked(Surface s1, Surface s2, const SurfaceMappingOptions& 
     detail::invalid("s2",
                     "lies apart from s1 (the surfaces neither cross nor enclose one another): consecutive "
                     "frames of one organ overlap; check their units and offsets");
-  }
-  if (options.method == MapMethod::uniform) {
-    detail::invalid("method",
-                    "uniform mapping has no 3D form; use 'minimal_distance', 'normal', 'diffusion' or 'auto'");
   }
   if (!(options.diffusion_mesh_size >= 0) || !std::isfinite(options.diffusion_mesh_size)) {
     detail::invalid("mesh_size", "must be a finite number >= 0");

@@ -7,6 +7,7 @@
 #include "common/interrupt_check.hpp"
 #include "common/validation.hpp"
 #include "surfaces/surface_mesh.hpp"
+#include "surfaces/surface_util.hpp"
 
 #include <CGAL/Polygon_mesh_processing/connected_components.h>
 #include <CGAL/Polygon_mesh_processing/orientation.h>
@@ -29,14 +30,7 @@ void require_input(const Points3Ref& vertices, const FacesRef& faces) {
   if (faces.rows() < 4)
     detail::invalid("surface", "has " + std::to_string(faces.rows()) + " faces: a closed surface needs at least 4");
   if (!vertices.allFinite()) detail::invalid("surface", "has a vertex with a non-finite coordinate");
-  for (Index f = 0; f < faces.rows(); ++f) {
-    for (int i = 0; i < 3; ++i) {
-      if (faces(f, i) < 0 || faces(f, i) >= vertices.rows()) {
-        detail::invalid("surface", "face " + std::to_string(f) + " refers to vertex " + std::to_string(faces(f, i)) +
-                                       ", outside 0.." + std::to_string(vertices.rows() - 1));
-      }
-    }
-  }
+  detail::require_face_indices(faces, vertices.rows(), "surface");
 }
 
 }  // namespace

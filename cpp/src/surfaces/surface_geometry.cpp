@@ -29,8 +29,8 @@ void require_face_indices(const FacesRef& faces, Index vertex_count, const char*
     for (int k = 0; k < 3; ++k) {
       const Index v = faces(j, k);
       if (v < 0 || v >= vertex_count) {
-        invalid(name, "face " + std::to_string(j) + " refers to vertex " + std::to_string(v) + ", outside 0.." +
-                          std::to_string(vertex_count - 1));
+        invalid(name, "vertex index " + std::to_string(v) + " is outside 0.." + std::to_string(vertex_count - 1) +
+                          " (face " + std::to_string(j) + ")");
       }
     }
   }
@@ -79,12 +79,11 @@ double check_closed_surface(const Points3Ref& vertices, const FacesRef& faces, c
   if (faces.rows() < 4) {
     detail::invalid(name, "a closed surface needs at least 4 faces, got " + std::to_string(faces.rows()));
   }
-  for (Index i = 0; i < vertices.rows(); ++i) {
-    if (!vertices.row(i).allFinite()) {
-      detail::invalid(name, "vertex " + std::to_string(i) + " has a non-finite coordinate");
-    }
-  }
-  detail::require_face_indices(faces, vertices.rows(), name);
+  // Named "NAME vertices" and "NAME faces": the words Python's own array checks use, as this is
+  // the one check of these rules on the way to mapping, quality and diffusion.
+  const std::string vertices_name = std::string(name) + " vertices", faces_name = std::string(name) + " faces";
+  detail::require_finite3(vertices, vertices_name.c_str());
+  detail::require_face_indices(faces, vertices.rows(), faces_name.c_str());
   // Coordinates about the centre of the bounding box keep the volume sum accurate far from 0.
   const V3 centre = 0.5 * (vertices.colwise().minCoeff() + vertices.colwise().maxCoeff()).transpose();
   double volume = 0.0;

@@ -21,13 +21,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._core import GeometryError
+from ..field import METHOD_NAMES
 from ..io import EXAMPLES, load_example, write_curve, write_field
 from ..io.atomic import atomic_text
 from ..mapping import map_curves
 from ..quality import quality
 
 #: The algorithms, in the paper's order, and the variants the demo runs for each.
-ALGORITHMS = ("minimal_distance", "normal", "diffusion", "uniform")
+ALGORITHMS = METHOD_NAMES[:4]  # the paper's four basic algorithms: the core's first codes
 VARIANTS = ("plain", "reverse", "transform")
 _VARIANT_ARGUMENTS = {"plain": {}, "reverse": {"reverse": True}, "transform": {"transform": True}}
 _TITLES = {"minimal_distance": "minimal distance", "normal": "normal", "diffusion": "diffusion",
