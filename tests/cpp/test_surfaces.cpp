@@ -163,6 +163,28 @@ int main() {
     CHECK(near.distances[i] <= best + 1e-15);
     CHECK_NEAR(near.distances[i], (near.points.row(i) - origins.row(i)).norm(), 1e-14);
   }
+  // Within a reach: the unlimited answer where it is that close, bit for bit, else nothing. (The
+  // reach is each query's own distance too, so that the bound itself is covered.)
+  for (const double reach : {0.0, 0.3, 1.0}) {
+    const SurfaceHits within = index.closest_points(origins, reach);
+    int found = 0;
+    for (Index i = 0; i < q; ++i) {
+      if (near.distances[i] <= reach) {
+        ++found;
+        CHECK(within.faces[i] == near.faces[i] && within.points.row(i) == near.points.row(i) &&
+              within.distances[i] == near.distances[i]);
+      } else {
+        CHECK(within.faces[i] == -1 && std::isnan(within.distances[i]) && std::isnan(within.points(i, 0)));
+      }
+    }
+    CHECK(reach == 0.0 || found > 0);
+  }
+  for (Index i = 0; i < q; ++i) {
+    const SurfaceHits own = index.closest_points(origins.row(i), near.distances[i]);
+    CHECK(own.faces[0] == near.faces[i] && own.distances[0] == near.distances[i]);
+  }
+  CHECK_THROWS(index.closest_points(origins, -1.0), InvalidInput);
+  CHECK_THROWS(index.closest_points(origins, std::nan("")), InvalidInput);
 
   // Mapping the sphere onto the ellipsoid.
   SurfaceMappingOptions options;

@@ -25,6 +25,9 @@ class SurfaceIndex {
   // Closest point on the surface to each query point (ties: the lowest face index, whatever the
   // traversal or thread count).
   SurfaceHits closest_points(const Points3Ref& queries) const;
+  // The same within max_distance (>= 0; infinity: no limit): rows with no point of the surface
+  // that close are NaN (faces: -1). Queries far from the surface cost next to nothing.
+  SurfaceHits closest_points(const Points3Ref& queries, double max_distance) const;
   // For each line origin + t * direction, t of either sign, the intersection with the surface
   // nearest to the origin, refined in double precision on the hit triangle.
   SurfaceHits line_intersections(const Points3Ref& origins, const Points3Ref& directions) const;

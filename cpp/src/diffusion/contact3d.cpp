@@ -96,7 +96,8 @@ ClearedSource clear_contact(const Points3Ref& source_vertices, const FacesRef& s
                             const ClosedSurface& target_surface, const SurfaceIndex& target_index, double clearance,
                             double tolerance) {
   const Index n = source_vertices.rows();
-  const SurfaceHits hits = target_index.closest_points(source_vertices);
+  // Only vertices within the clearance (or the touching tolerance) of the target matter here.
+  const SurfaceHits hits = target_index.closest_points(source_vertices, std::max(clearance, tolerance));
   ClearedSource cleared;
   cleared.vertices = source_vertices;
   cleared.closest = hits.points;

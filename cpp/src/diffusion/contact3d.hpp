@@ -17,7 +17,8 @@ namespace morphomap::detail {
 struct ClearedSource {
   Points3 vertices;            // the source, its vertices near the target pulled back
   std::vector<char> touching;  // per source vertex: within the contact tolerance of the target
-  Points3 closest;             // per source vertex: its closest point on the target
+  Points3 closest;             // per source vertex within the clearance or the tolerance: its closest
+                               // point on the target (NaN further away)
   Index moved = 0;             // how many vertices were pulled back
   double near_area = 0.0;      // of the source faces whose corners all lie within the clearance
 };

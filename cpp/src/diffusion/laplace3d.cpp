@@ -106,8 +106,9 @@ class Tracer {
     // tetrahedra at such a curve the flow is the element's own -grad c (the P1 field), which
     // points away from the source faces and out through the target faces. NaN elsewhere.
     element_flow_.assign(tets, Vec3::Constant(kNaN));
-    Eigen::Matrix<double, 4, 3> g;
+    gradients_.resize(static_cast<std::size_t>(tets));
     for (Index t = 0; t < tets; ++t) {
+      Eigen::Matrix<double, 4, 3>& g = gradients_[static_cast<std::size_t>(t)];
       const double volume = std::abs(detail::tetrahedron_gradients(mesh.vertices, mesh.tetrahedra, t, g));
       Vec3 flow = Vec3::Zero();
       bool at_crossing = false;
@@ -243,33 +244,40 @@ class Tracer {
     });
   }
 
+  // From the gradients of the barycentric coordinates, kept from the constructor: a streamline
+  // asks for them about ten times per step, and solving the tetrahedron's 3 x 3 system each time
+  // was most of the trace.
   Vec4 barycentric(Index t, const Vec3& x) const {
-    const Vec3 p0 = point(mesh_.tetrahedra(t, 0));
-    Eigen::Matrix3d edges;
-    for (int i = 0; i < 3; ++i) edges.col(i) = point(mesh_.tetrahedra(t, i + 1)) - p0;
-    const Vec3 l = edges.partialPivLu().solve(x - p0);
-    return Vec4(1.0 - l.sum(), l[0], l[1], l[2]);
+    Vec4 l = gradients_[static_cast<std::size_t>(t)] * (x - point(mesh_.tetrahedra(t, 0)));
+    l[0] += 1.0;
+    return l;
   }
 
   // The tetrahedron containing x, walking from t towards it; the last one reached if x lies
   // outside the mesh (the field is then extrapolated from there).
-  Index locate(Index t, const Vec3& x) const {
+  // l: x's barycentric coordinates in the tetrahedron returned.
+  Index locate(Index t, const Vec3& x, Vec4& l) const {
     for (int k = 0; k < kWalkLimit; ++k) {
-      const Vec4 l = barycentric(t, x);
+      l = barycentric(t, x);
       int i;
       if (l.minCoeff(&i) >= -1e-12) return t;
       const Index next = mesh_.neighbours(t, i);
       if (next < 0) return t;
       t = next;
     }
+    l = barycentric(t, x);
     return t;
+  }
+  Index locate(Index t, const Vec3& x) const {
+    Vec4 l;
+    return locate(t, x, l);
   }
 
   Vec3 direction(Index t, const Vec3& x) const {
-    t = locate(t, x);
+    Vec4 l;
+    t = locate(t, x, l);
     Vec3 u = element_flow_[t];
     if (std::isnan(u.x())) {
-      const Vec4 l = barycentric(t, x);
       u.setZero();
       for (int i = 0; i < 4; ++i) u += l[i] * velocity_[mesh_.tetrahedra(t, i)];
     }
@@ -322,6 +330,8 @@ class Tracer {
   std::vector<Vec3> velocity_;      // recovered -grad c at the vertices
   std::vector<Vec3> element_flow_;  // -grad c of the tetrahedra at a crossing curve, else NaN
   std::vector<double> step_;        // RK4 step length in each tetrahedron
+  // Gradients of each tetrahedron's barycentric coordinates (rows; tetrahedron_gradients).
+  std::vector<Eigen::Matrix<double, 4, 3>> gradients_;
 };
 
 // The source cleared of its contact with the target (contact3d.hpp), and how it then lies

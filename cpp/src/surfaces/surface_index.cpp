@@ -357,17 +357,23 @@ struct SurfaceIndex::Impl {
   // Whether q is close enough for the float scene: within 1e30 unit-box lengths of its centre.
   bool within_reach(const V3& q) const { return ((q - centre) * scale).cwiseAbs().maxCoeff() <= kReach; }
 
-  Hit closest(const V3& q) const {
+  // The closest point within `reach` of q (infinite: anywhere), else no hit. A finite reach is the
+  // search's starting radius: far from the surface Embree then skips the whole tree at once, where
+  // an unbounded search visits every triangle about as close as the nearest (nested surfaces are
+  // almost equidistant over wide patches) before its radius shrinks.
+  Hit closest(const V3& q, double reach) const {
     const V3 qs = (q - centre) * scale;
     PointQuery pq{this, q, 1e-6 * (1.0 + qs.cwiseAbs().maxCoeff()), kInf, Hit{}};
     RTCPointQuery query;
     query.x = static_cast<float>(qs.x()), query.y = static_cast<float>(qs.y()), query.z = static_cast<float>(qs.z());
     query.time = 0.0f;
-    query.radius = std::numeric_limits<float>::infinity();
+    const double radius = reach * scale * (1.0 + 1e-6) + 2.0 * pq.margin;
+    query.radius = radius < 1e30 ? static_cast<float>(radius) : std::numeric_limits<float>::infinity();
     RTCPointQueryContext context;
     rtcInitPointQueryContext(&context);
     rtcPointQuery(scene, &query, &context, &Impl::visit, &pq);
     pq.hit.distance = std::sqrt(pq.best_d2);
+    if (!(pq.hit.distance <= reach)) return Hit{};  // the distance as reported, not its square
     return pq.hit;
   }
 };
@@ -390,8 +396,11 @@ SurfaceIndex::~SurfaceIndex() = default;
 SurfaceIndex::SurfaceIndex(SurfaceIndex&&) noexcept = default;
 SurfaceIndex& SurfaceIndex::operator=(SurfaceIndex&&) noexcept = default;
 
-SurfaceHits SurfaceIndex::closest_points(const Points3Ref& queries) const {
+SurfaceHits SurfaceIndex::closest_points(const Points3Ref& queries) const { return closest_points(queries, kInf); }
+
+SurfaceHits SurfaceIndex::closest_points(const Points3Ref& queries, double max_distance) const {
   detail::require_finite3(queries, "queries");
+  if (!(max_distance >= 0.0)) detail::invalid("max_distance", "must be >= 0 (infinity: no limit)");
   // Beyond that, Embree's float query is meaningless, and the double distances overflow.
   for (Index i = 0; i < queries.rows(); ++i) {
     if (!impl_->within_reach(queries.row(i).transpose())) {
@@ -401,7 +410,8 @@ SurfaceHits SurfaceIndex::closest_points(const Points3Ref& queries) const {
   }
   SurfaceHits hits = allocate_hits(queries.rows());
   tbb::parallel_for(tbb::blocked_range<Index>(0, queries.rows(), kGrain), [&](const tbb::blocked_range<Index>& range) {
-    for (Index i = range.begin(); i < range.end(); ++i) store(hits, i, impl_->closest(queries.row(i).transpose()));
+    for (Index i = range.begin(); i < range.end(); ++i)
+      store(hits, i, impl_->closest(queries.row(i).transpose(), max_distance));
   });
   return hits;
 }
