@@ -209,6 +209,22 @@ def test_bad_input():
         mm.solve_diffusion_3d((bad, s1[1]), s2)
 
 
+def test_a_surface_enclosing_no_volume_is_named_whichever_way_diffusion_runs():
+    # A closed tetrahedron 1e-13 high passes the closed-surface checks but leaves no region to mesh.
+    flat = (np.array([[-2.0, -2, 0], [3, -2, 0], [-2, 3, 0], [0, 0, 1e-13]]),
+            np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]]))
+    ball = sphere(1.0, 2)
+    for reverse in (False, True):
+        with pytest.raises(ValueError, match="^s2: encloses no volume"):
+            mm.map_surfaces(ball, flat, "diffusion", reverse=reverse)
+        with pytest.raises(ValueError, match="^s1: encloses no volume"):
+            mm.map_surfaces(flat, ball, "diffusion", reverse=reverse)
+    with pytest.raises(ValueError, match="^s1: encloses no volume"):
+        mm.solve_diffusion_3d(flat, ball)
+    field = mm.map_surfaces(ball, flat, "auto")  # no diffusion to fall back on: minimal distance
+    assert field.valid.all() and set(field.method) <= {"normal", "minimal_distance"}
+
+
 def test_a_coarse_inner_sphere_is_as_accurate_by_default():
     # 642 vertices (icosphere 3) inside and out: the mesh near S1 is sized from S1's extent, not
     # from its coarse triangles (at their size the RMS end error was 0.018).

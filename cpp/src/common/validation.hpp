@@ -63,6 +63,13 @@ void require_no_self_intersection(const Points2Ref& points, bool closed, const c
 // Mapping and quality need that (an inward surface would fold every triangle).
 void require_outward(double volume, const char* name);
 
+// Whether that volume is more than rounding against the surface's size: faces that enclose no
+// volume (two sheets on each other) leave 3D diffusion no region to mesh.
+bool encloses_volume(double volume, const Points3Ref& vertices);
+// InvalidInput "name: encloses no volume" unless encloses_volume; diffusion's rule, checked at the
+// entries that run it (map_surfaces with "diffusion", solve_diffusion_3d).
+void require_volume(double volume, const Points3Ref& vertices, const char* name);
+
 // A contact tolerance (CurveMappingOptions::contact_tolerance) is finite; negative asks for the default.
 void require_contact_tolerance(double value);
 

@@ -59,9 +59,9 @@ struct SurfaceFacts {
   double mean_edge = 0.0;
 };
 
-// Measures a surface that passed check_closed_surface (`volume`: the size of its volume). Its
-// faces may enclose no volume at all: no region to mesh then.
-SurfaceFacts measure_surface(const Points3Ref& vertices, const FacesRef& faces, double volume, const char* name) {
+// Measures a surface that passed check_closed_surface and require_volume (`volume`: the size of
+// its volume).
+SurfaceFacts measure_surface(const Points3Ref& vertices, const FacesRef& faces, double volume) {
   SurfaceFacts facts;
   facts.volume = volume;
   for (Index f = 0; f < faces.rows(); ++f) {
@@ -71,8 +71,6 @@ SurfaceFacts measure_surface(const Points3Ref& vertices, const FacesRef& faces, 
     facts.mean_edge += ((b - a).norm() + (c - b).norm() + (a - c).norm()) / 3.0;
   }
   facts.mean_edge /= faces.rows();
-  const double scale = (vertices.colwise().maxCoeff() - vertices.colwise().minCoeff()).norm();
-  if (!(facts.volume > 1e-12 * scale * scale * scale)) detail::invalid(name, "encloses no volume");
   return facts;
 }
 
@@ -386,6 +384,8 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
   const auto clock = std::chrono::steady_clock::now();
   const double source_volume = check_closed_surface(source_vertices, source_faces, "s1");
   const double target_volume = check_closed_surface(target_vertices, target_faces, "s2");
+  detail::require_volume(std::abs(source_volume), source_vertices, "s1");
+  detail::require_volume(std::abs(target_volume), target_vertices, "s2");
   // Mesh_3 and the nesting tests want outward orientation.
   Faces source_out = source_faces, target_out = target_faces;
   if (source_volume < 0.0) source_out.col(1).swap(source_out.col(2));
@@ -410,8 +410,8 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
 ShellDiffusionSolution detail::solve_diffusion_3d(const ShellPair& pair, const ShellDiffusionOptions& options) {
   const Points3Ref& source_vertices = pair.source_vertices;
   const Points3Ref& target_vertices = pair.target_vertices;
-  const SurfaceFacts source = measure_surface(source_vertices, pair.source_faces, pair.source_volume, "s1");
-  const SurfaceFacts target = measure_surface(target_vertices, pair.target_faces, pair.target_volume, "s2");
+  const SurfaceFacts source = measure_surface(source_vertices, pair.source_faces, pair.source_volume);
+  const SurfaceFacts target = measure_surface(target_vertices, pair.target_faces, pair.target_volume);
   const auto stage = [&](const char* name) {
     if (options.on_stage) options.on_stage(name);
   };

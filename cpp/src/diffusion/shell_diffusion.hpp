@@ -10,7 +10,8 @@
 
 namespace morphomap::detail {
 
-// A source and a target that passed check_closed_surface with outward faces, as the arrays and
+// A source and a target that passed check_closed_surface with outward faces and require_volume
+// (or encloses_volume), as the arrays and
 // as their CGAL forms, with their signed volumes, their nesting (classify_nesting(source,
 // target), not disjoint) and the target's index (of exactly these arrays).
 struct ShellPair {

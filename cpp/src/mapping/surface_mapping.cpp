@@ -136,7 +136,12 @@ DisplacementField3 automatic(const Pair& pair, const SurfaceIndex& target_index,
                              target.vertices, target.faces, target_index) == 0) {
     return normal;
   }
+  // Diffusion needs a region between the surfaces; where one of them encloses no volume the
+  // attempts would be refused (require_volume), so they are not made.
+  const bool diffusable = detail::encloses_volume(source.volume, source.vertices) &&
+                          detail::encloses_volume(target.volume, target.vertices);
   for (const bool backwards : {true, false}) {
+    if (!diffusable) break;
     try {
       DisplacementField3 field =
           backwards ? flipped(basic(MapMethod::diffusion, pair.swapped(), source_index, diffusion, &target_index))
@@ -170,6 +175,10 @@ DisplacementField3 checked(Surface s1, Surface s2, const SurfaceMappingOptions& 
   if (std::find(std::begin(kSurfaceMethods), std::end(kSurfaceMethods), options.method) == std::end(kSurfaceMethods)) {
     detail::invalid("method", std::string(map_method_name(options.method)) + " mapping has no 3D form; use " +
                                   quoted_method_names(std::begin(kSurfaceMethods), std::end(kSurfaceMethods)));
+  }
+  if (options.method == MapMethod::diffusion) {
+    detail::require_volume(s1.volume, s1.vertices, "s1");
+    detail::require_volume(s2.volume, s2.vertices, "s2");
   }
   std::unique_ptr<const detail::ClosedSurface> built1, built2;
   s1.closed = &closed_of(s1, built1);

@@ -43,6 +43,15 @@ void require_outward(double volume, const char* name) {
   }
 }
 
+bool encloses_volume(double volume, const Points3Ref& vertices) {
+  const double scale = (vertices.colwise().maxCoeff() - vertices.colwise().minCoeff()).norm();
+  return volume > 1e-12 * scale * scale * scale;
+}
+
+void require_volume(double volume, const Points3Ref& vertices, const char* name) {
+  if (!encloses_volume(volume, vertices)) invalid(name, "encloses no volume");
+}
+
 }  // namespace detail
 
 using detail::V3;
