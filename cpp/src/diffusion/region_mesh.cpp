@@ -52,9 +52,9 @@ using Point = Cdt::Point;
 // circumdiameter (2 / sqrt(3) spacings, 1.12 max_edge). A point the mesher puts inside the lattice
 // joins the lattice points whose circumcircles hold it, all within that distance. Under the plain
 // bound (a spacing is 0.97 of it) its spokes to the next row were too long: the mesher split them
-// at their triangles' circumcentres, which are the centres of the next lattice triangles, so on
-// along a lattice direction. Confocal ellipses, 10^4 points per curve: 661 such vertices more than
-// 1.5 spacings from the curves, 8 now, and the worst streamline 1.05e-3 of the gap off, 4.3e-4 now.
+// at their triangles' circumcentres, which are the centres of the next lattice triangles, and so
+// on along a lattice direction, refining deep into the lattice and bending the streamlines there
+// (bench/README.md, "Diffusion mapping", has the counts).
 // Triangles with a loop's or a layer's point keep the plain bound (the strip is graded as before).
 class Criteria : public CGAL::Delaunay_mesh_size_criteria_2<Cdt> {
   using Base = CGAL::Delaunay_mesh_size_criteria_2<Cdt>;
@@ -217,8 +217,7 @@ std::vector<Point> lattice_points(const std::vector<Points2>& loops, const std::
 // marked faces tell), so that the mesher is left little to grade. Points closer to a loop than
 // most of their layer's distance (narrow gaps, sharp bends) are dropped. Without them the mesher
 // grades a strip a lattice spacing wide down to the points' spacing on its own, inserting into
-// fans of long thin triangles, and its time grew superlinearly (confocal ellipses, 10^5 points
-// per curve: 6.7 s against 2.8 s with the layers).
+// fans of long thin triangles, and its time grows faster than the number of points.
 std::vector<Point> layer_points(const Cdt& cdt, const std::vector<Points2>& loops,
                                 const std::vector<CurveIndex>& indexes, double limit) {
   std::vector<double> xy, away;
