@@ -266,6 +266,35 @@ def test_same_input_same_mesh_and_field_in_other_processes_and_thread_counts():
     assert len(set(lines[1::2])) == 1, lines
 
 
+_THREADS_SCRIPT = """
+import hashlib, threading
+import numpy as np, scipy.linalg, trimesh  # SciPy's OpenBLAS brings a fork handler of its own
+import morphomap as mm
+a = trimesh.creation.icosphere(2)
+s1 = (np.array(a.vertices), np.array(a.faces))
+s2 = (np.array(a.vertices) * [2.0, 1.5, 1.2], np.array(a.faces))
+digests = []
+def diffusion():
+    for _ in range(4):
+        digests.append(hashlib.sha256(mm.solve_diffusion_3d(s1, s2, mesh_size=0.5).ends.tobytes()).hexdigest())
+threads = [threading.Thread(target=diffusion) for _ in range(3)]
+for t in threads: t.start()
+for t in threads: t.join()
+print(len(digests), len(set(digests)))
+"""
+
+
+def test_threads_meshing_at_once_neither_hang_nor_differ():
+    # Each mesh is made in a forked child. Two threads forking at once ran OpenBLAS's fork handler
+    # twice at once, and it joined one of its threads twice: the process hung (about one run in two).
+    import subprocess
+    import sys
+
+    run = subprocess.run([sys.executable, "-c", _THREADS_SCRIPT], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert run.stdout.split() == ["12", "1"], run.stdout
+
+
 def test_progress_reports_the_stages(capsys):
     s1, s2 = sphere(1.0, 2), sphere(axes=(2.0, 1.5, 1.2), subdivisions=2)
     quiet = mm.solve_diffusion_3d(s1, s2, progress=False)

@@ -7,8 +7,14 @@
 
 #include "check.hpp"
 
+#include <pthread.h>
+
+#include <atomic>
+#include <chrono>
 #include <csignal>
 #include <string>
+#include <thread>
+#include <vector>
 
 using morphomap::detail::mesh_in_child;
 using morphomap::detail::ShellMesh;
@@ -72,11 +78,39 @@ void a_crash_is_an_error() {
   round_trip();  // and the guard still works afterwards
 }
 
+// Threads that mesh at once fork one at a time: a library's fork handlers (OpenBLAS's joins its
+// threads) may not run twice at once. A prepare handler of our own sees whether two forks overlap;
+// its pause makes an overlap near certain if the guard lets forks run together.
+std::atomic<int> forks_in_prepare{0};
+std::atomic<bool> forks_overlapped{false};
+
+void forks_are_serialized() {
+  ::pthread_atfork(
+      [] {
+        if (forks_in_prepare.fetch_add(1) > 0) forks_overlapped = true;
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      },
+      [] { forks_in_prepare.fetch_sub(1); }, nullptr);
+  const ShellMesh sent = one_tetrahedron();
+  std::vector<int> intact(4, 0);
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 4; ++t) {
+    threads.emplace_back([&, t] {
+      for (int k = 0; k < 5; ++k)
+        intact[t] += mesh_in_child([&] { return sent; }, "test").tetrahedra == sent.tetrahedra;
+    });
+  }
+  for (auto& thread : threads) thread.join();
+  CHECK(!forks_overlapped);
+  for (const int count : intact) CHECK(count == 5);
+}
+
 }  // namespace
 
 int main() {
   round_trip();
   exceptions_come_back();
   a_crash_is_an_error();
+  forks_are_serialized();
   TEST_MAIN_END();
 }

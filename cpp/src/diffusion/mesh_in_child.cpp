@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -158,12 +159,22 @@ struct Child {
   }
 };
 
+// fork(), one thread at a time in this process. fork() runs every library's prepare handler in the
+// forking thread, and some are not safe to run twice at once: OpenBLAS's (loaded with SciPy) joins
+// its worker threads, and two concurrent forks joined the same thread, so one waited forever
+// (three Python threads meshing at once hung in about one run in two).
+pid_t fork_one_at_a_time() {
+  static std::mutex forking;
+  const std::lock_guard<std::mutex> lock(forking);
+  return ::fork();
+}
+
 }  // namespace
 
 ShellMesh mesh_in_child(const std::function<ShellMesh()>& make, const char* what) {
   int fds[2];
   if (::pipe(fds) != 0) return make();  // no pipe to spare: mesh here
-  const pid_t pid = ::fork();
+  const pid_t pid = fork_one_at_a_time();
   if (pid < 0) {
     ::close(fds[0]);
     ::close(fds[1]);
