@@ -17,6 +17,8 @@
    only, never a dependency) meshing the shell with quality switches, then scikit-fem's P1
    assembly. Each case runs in its own process; peak memory is the process's plus its children's
    (the mesher's) largest resident sets, an upper bound.
+
+--all-cores runs every table with repeatable=False (Mesh_3's parallel mode on all cores).
 """
 
 from __future__ import annotations
@@ -37,6 +39,7 @@ trimesh = pytest.importorskip("trimesh")
 
 FIGURE12_AXES = np.array([2.0, 1.5, 1.2])
 CROSSING_AXES, CROSSING_CENTRE = np.array([1.3, 1.0, 1.0]), np.array([0.6, 0.05, 0.03])
+REPEATABLE = True  # False with --all-cores
 
 
 def icosphere(subdivisions, axes=(1.0, 1.0, 1.0), centre=(0.0, 0.0, 0.0)):
@@ -66,7 +69,7 @@ def round_trip_errors(s1, s2, forward_ends, backward_ends):
 
 def timed(s1, s2, mesh_size):
     start = time.perf_counter()
-    solution = mm.solve_diffusion_3d(s1, s2, mesh_size=mesh_size)
+    solution = mm.solve_diffusion_3d(s1, s2, mesh_size=mesh_size, repeatable=REPEATABLE)
     return solution, time.perf_counter() - start
 
 
@@ -111,7 +114,7 @@ def crossing_table(sizes):
     s2 = icosphere(4, CROSSING_AXES, CROSSING_CENTRE)
     for size in sizes:
         forward, total = timed(s1, s2, size)
-        backward = mm.solve_diffusion_3d(s2, s1, mesh_size=size)
+        backward = mm.solve_diffusion_3d(s2, s1, mesh_size=size, repeatable=REPEATABLE)
         ok = np.isfinite(forward.ends).all(axis=1)
         error = round_trip_errors(s1, s2, forward.ends, backward.ends)[ok]
         print(f"{str(size):>9} {len(forward.tetrahedra):>8} {(~ok).sum():>5} {np.sqrt(np.mean(error**2)):>9.2e} "
@@ -204,13 +207,14 @@ def organ_peer(faces):
 def organ_table(sizes, peer_sizes):
     """Each case in a fresh process (peak memory of its own), the peer beside it."""
     def run(kind, faces):
-        done = subprocess.run([sys.executable, __file__, "--case", kind, str(faces)], capture_output=True, text=True,
-                              check=False)
+        command = [sys.executable, __file__, "--case", kind, str(faces)] + ([] if REPEATABLE else ["--all-cores"])
+        done = subprocess.run(command, capture_output=True, text=True, check=False)
         if done.returncode != 0:
             return {"error": done.stderr.strip().splitlines()[-1:]}
         return json.loads(done.stdout.strip().splitlines()[-1])
 
-    print("\n4. Lumpy nested pairs (radius ~1 in ~2): end to end, and TetGen + scikit-fem assembly")
+    print("\n4. Lumpy nested pairs (radius ~1 in ~2): end to end, and TetGen + scikit-fem assembly"
+          + ("" if REPEATABLE else " (morphomap: repeatable=False)"))
     print("| faces per surface | tetrahedra | mesh s | solve s | trace s | total s | CPU s | lost | folds "
           "| peak memory GB | TetGen tetrahedra | TetGen s | assembly s | peer CPU s | peer memory GB "
           "| peer / morphomap (wall, CPU) |")
@@ -254,8 +258,11 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quick", action="store_true", help="default mesh sizes only")
     parser.add_argument("--organ", action="store_true", help="only the organ-scale table (4), ~10 min")
+    parser.add_argument("--all-cores", action="store_true", help="repeatable=False: Mesh_3 on all cores")
     parser.add_argument("--case", nargs=2, metavar=("KIND", "FACES"), help=argparse.SUPPRESS)
     args = parser.parse_args()
+    global REPEATABLE
+    REPEATABLE = not args.all_cores
     if args.case:
         kind, faces = args.case[0], int(args.case[1])
         print(json.dumps(organ_morphomap(faces) if kind == "morphomap" else organ_peer(faces)))

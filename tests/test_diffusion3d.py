@@ -203,6 +203,10 @@ def test_bad_input():
         mm.solve_diffusion_3d(s1, s2, mesh_size="fine")
     with pytest.raises(TypeError, match="s1"):
         mm.solve_diffusion_3d("sphere", s2)
+    with pytest.raises(TypeError, match="repeatable"):
+        mm.solve_diffusion_3d(s1, s2, repeatable="no")
+    with pytest.raises(TypeError, match="repeatable"):
+        mm.map_surfaces(s1, s2, "diffusion", repeatable=None)
     bad = s1[0].copy()
     bad[0, 0] = np.nan
     with pytest.raises(ValueError, match="s1"):
@@ -293,6 +297,54 @@ def test_threads_meshing_at_once_neither_hang_nor_differ():
     run = subprocess.run([sys.executable, "-c", _THREADS_SCRIPT], capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stderr[-2000:]
     assert run.stdout.split() == ["12", "1"], run.stdout
+
+
+def test_meshing_on_all_cores_is_as_accurate():
+    # repeatable=False: Mesh_3's parallel mode, in a child with TBB workers of its own; the mesh
+    # follows the threads, the accuracy bounds are those of the repeatable mesh above.
+    inner, outer = sphere(1.0), sphere(4.0)
+    solution = mm.solve_diffusion_3d(inner, outer, repeatable=False)
+    assert np.isfinite(solution.ends).all()
+    assert angular_rms(inner[0], solution.ends, 4.0) < 0.01
+    r = np.linalg.norm(solution.vertices, axis=1)
+    assert np.abs(solution.potential - np.clip((1 / r - 0.25) / 0.75, 0, 1)).max() < 0.01
+    field = mm.DisplacementField(inner[0], solution.ends, np.full(len(inner[0]), "diffusion"), faces=inner[1])
+    assert mm.quality(field, inner, outer).folds == 0
+    ellipsoid = sphere(axes=(2.0, 1.5, 1.2), subdivisions=3)
+    mapped = mm.map_surfaces(sphere(1.0, 3), ellipsoid, "diffusion", repeatable=False)
+    assert mapped.valid.all() and mm.quality(mapped, sphere(1.0, 3), ellipsoid).folds == 0
+
+
+_PARALLEL_BESIDE_THREADS_SCRIPT = """
+import threading
+import numpy as np, scipy.linalg, trimesh
+import morphomap as mm
+a = trimesh.creation.icosphere(3)
+s1 = (np.array(a.vertices), np.array(a.faces))
+s2 = (np.array(a.vertices) * [2.0, 1.5, 1.2], np.array(a.faces))
+lost = []
+def diffusion():
+    for _ in range(3):
+        lost.append(int((~np.isfinite(mm.solve_diffusion_3d(s1, s2, repeatable=False).ends)).sum()))
+def normals():  # TBB and Embree work in this process while the meshers fork
+    for _ in range(40):
+        mm.map_surfaces(s1, s2, "normal")
+threads = [threading.Thread(target=f) for f in (diffusion, diffusion, normals)]
+for t in threads: t.start()
+for t in threads: t.join()
+print(len(lost), sum(lost))
+"""
+
+
+def test_meshing_on_all_cores_beside_other_threads_neither_hangs_nor_loses_points():
+    # Each fork stops this process's TBB workers first; a thread that enters TBB between that and
+    # the fork could leave the child waiting on a lock: it is then replaced by a one-thread child.
+    import subprocess
+    import sys
+
+    run = subprocess.run([sys.executable, "-c", _PARALLEL_BESIDE_THREADS_SCRIPT], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert run.stdout.split() == ["6", "0"], run.stdout
 
 
 def test_progress_reports_the_stages(capsys):

@@ -423,7 +423,7 @@ def test_a_raising_progress_callback_leaves_the_call_cleanly(monkeypatch):
         raise RuntimeError(f"stopped at {stage}")
 
     with pytest.raises(RuntimeError, match="stopped at mesh"):
-        _core.map_surfaces(v1, f1, v2, f2, "diffusion", False, 0.0, stop)
+        _core.map_surfaces(v1, f1, v2, f2, "diffusion", False, 0.0, True, stop)
     closed = []
     monkeypatch.setattr(StageBar, "_on_stage", lambda self, stage: (_ for _ in ()).throw(KeyboardInterrupt()))
     monkeypatch.setattr(StageBar, "close", lambda self: closed.append(self.bar.n))

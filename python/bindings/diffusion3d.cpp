@@ -18,9 +18,11 @@ void bind_diffusion3d(py::module_& m) {
   m.def(
       "solve_diffusion_3d",
       [](const Points3Ref& source_vertices, const FacesRef& source_faces, const Points3Ref& target_vertices,
-         const FacesRef& target_faces, double mesh_size, bool keep_streamlines, const py::object& on_stage) {
+         const FacesRef& target_faces, double mesh_size, bool keep_streamlines, bool repeatable,
+         const py::object& on_stage) {
         ShellDiffusionOptions options;
         options.mesh_size = mesh_size;
+        options.repeatable = repeatable;
         options.keep_streamlines = keep_streamlines;
         options.on_stage = stage_callback(on_stage);
         ShellDiffusionSolution solution;
@@ -48,5 +50,5 @@ void bind_diffusion3d(py::module_& m) {
         return result;
       },
       py::arg("source_vertices"), py::arg("source_faces"), py::arg("target_vertices"), py::arg("target_faces"),
-      py::arg("mesh_size"), py::arg("keep_streamlines"), py::arg("on_stage") = py::none());
+      py::arg("mesh_size"), py::arg("keep_streamlines"), py::arg("repeatable"), py::arg("on_stage") = py::none());
 }

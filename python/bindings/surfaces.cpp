@@ -82,11 +82,12 @@ void bind_surfaces(py::module_& m) {
   m.def(
       "map_surfaces",
       [](const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2, const std::string& method,
-         bool reverse, double mesh_size, const py::object& on_stage) {
+         bool reverse, double mesh_size, bool repeatable, const py::object& on_stage) {
         SurfaceMappingOptions options;
         options.method = map_method_named(method);
         options.reverse = reverse;
         options.diffusion_mesh_size = mesh_size;
+        options.diffusion_repeatable = repeatable;
         options.on_stage = stage_callback(on_stage);
         DisplacementField3 field;
         InterruptGuard interruptible;
@@ -97,16 +98,17 @@ void bind_surfaces(py::module_& m) {
         return field_record(std::move(field));
       },
       py::arg("v1"), py::arg("f1"), py::arg("v2"), py::arg("f2"), py::arg("method"), py::arg("reverse"),
-      py::arg("mesh_size"), py::arg("on_stage") = py::none());
+      py::arg("mesh_size"), py::arg("repeatable"), py::arg("on_stage") = py::none());
 
   m.def(
       "map_prepared_surfaces",
       [](const PreparedSurface& s1, const PreparedSurface& s2, const std::string& method, bool reverse,
-         double mesh_size, const py::object& on_stage) {
+         double mesh_size, bool repeatable, const py::object& on_stage) {
         SurfaceMappingOptions options;
         options.method = map_method_named(method);
         options.reverse = reverse;
         options.diffusion_mesh_size = mesh_size;
+        options.diffusion_repeatable = repeatable;
         options.on_stage = stage_callback(on_stage);
         DisplacementField3 field;
         InterruptGuard interruptible;
@@ -117,7 +119,7 @@ void bind_surfaces(py::module_& m) {
         return field_record(std::move(field));
       },
       py::arg("s1"), py::arg("s2"), py::arg("method"), py::arg("reverse"), py::arg("mesh_size"),
-      py::arg("on_stage") = py::none());
+      py::arg("repeatable"), py::arg("on_stage") = py::none());
   m.def(
       "prepared_surface_quality",
       [](const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, const PreparedSurface& s1,

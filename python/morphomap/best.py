@@ -286,7 +286,7 @@ def map_best(c1, c2, *, closed=True, n=None, split=True, anchor=None, density_th
     return _pick(results + ([assembled] if assembled else []), tuple(piece_rows))
 
 
-def map_best_surfaces(s1, s2, *, mesh_size=None, skip_below=None, workers=None):
+def map_best_surfaces(s1, s2, *, mesh_size=None, repeatable=True, skip_below=None, workers=None):
     """3D ``method="best"``: see the module's documentation; the pair is one subproblem (no
     per-piece choice, no ``piece_candidates``). Called by :func:`map_surfaces`."""
     from .quality import quality
@@ -295,7 +295,8 @@ def map_best_surfaces(s1, s2, *, mesh_size=None, skip_below=None, workers=None):
     s1, s2 = as_surface(s1, "s1"), as_surface(s2, "s2")
 
     def job(name, method, reverse=False, transform=False):
-        return (name, lambda: map_surfaces(s1, s2, method, reverse=reverse, mesh_size=mesh_size, progress=False),
+        return (name, lambda: map_surfaces(s1, s2, method, reverse=reverse, mesh_size=mesh_size,
+                                           repeatable=repeatable, progress=False),
                 lambda field: quality(field, s1, s2))
 
     cheap = [job(*row) for row in _plan(("normal", "minimal_distance"), (False,))] + [job("auto", "auto")]

@@ -41,7 +41,8 @@ class ShellDiffusionSolution:
     seconds: dict
 
 
-def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False, progress=None) -> ShellDiffusionSolution:
+def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False, progress=None,
+                       repeatable=True) -> ShellDiffusionSolution:
     """Solve Laplace's equation between S1 (c = 1) and S2 (c = 0) and trace the streamlines.
 
     Parameters
@@ -71,20 +72,25 @@ def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False, progress=No
     progress : bool, optional
         A progress bar (tqdm) on stderr naming the stage (mesh, solve, trace); by default when
         stderr is a terminal and the call runs longer than 3 seconds.
+    repeatable : bool
+        True (default): the same input gives the same mesh, potential and ends, bit for bit, in
+        any process and with any number of threads (the mesher runs on one core with fixed
+        random choices). False: the mesher runs in CGAL's parallel mode on all cores (nested
+        surfaces; crossing ones still mesh on one core). It is faster, but the mesh depends on
+        how the threads ran, so the ends differ from run to run within the discretisation error.
 
     Returns
     -------
     ShellDiffusionSolution
-        ``ends[i]`` is the image of vertex ``i`` of S1 on S2. The same input gives the same mesh,
-        potential and ends, bit for bit, in any process and with any number of threads (the
-        mesher runs on one core with fixed random choices).
+        ``ends[i]`` is the image of vertex ``i`` of S1 on S2.
     """
     v1, f1 = as_surface(s1, "s1", core_checks=True)
     v2, f2 = as_surface(s2, "s2", core_checks=True)
     size, keep = as_real(mesh_size, "mesh_size", 0.0), as_flag(streamlines, "streamlines")
+    repeat = as_flag(repeatable, "repeatable")
     bar = StageBar(progress, "solve_diffusion_3d", DIFFUSION_STAGES)
     try:
-        solved = _core.solve_diffusion_3d(v1, f1, v2, f2, size, keep, bar.callback)
+        solved = _core.solve_diffusion_3d(v1, f1, v2, f2, size, keep, repeat, bar.callback)
     finally:
         bar.close()
     return ShellDiffusionSolution(solved["vertices"], solved["tetrahedra"], solved["potential"], solved["ends"],

@@ -119,8 +119,8 @@ def surface_normals(vertices, faces) -> np.ndarray:
     return _core.vertex_normals(vertices, as_faces(faces, "faces", len(vertices)))
 
 
-def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None, skip_below=None,
-                 workers=None, progress=None) -> DisplacementField:
+def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None, repeatable=True,
+                 skip_below=None, workers=None, progress=None) -> DisplacementField:
     """Map closed surface ``s1`` (time t) onto closed surface ``s2`` (time t + dt).
 
     Parameters
@@ -155,6 +155,9 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None, skip
     mesh_size : float, optional
         The tetrahedral mesh of diffusion mapping (also within ``"auto"``), as in
         :func:`solve_diffusion_3d`.
+    repeatable : bool
+        Diffusion mapping (also within ``"auto"`` and ``"best"``): ``False`` meshes on all cores,
+        faster but not the same field bit for bit from run to run (see :func:`solve_diffusion_3d`).
     skip_below, workers : optional
         ``"best"`` only: see :mod:`morphomap.best`.
     progress : bool, optional
@@ -181,7 +184,8 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None, skip
                              "leave it None or False")
         if reverse:
             raise ValueError("reverse: method 'best' tries the reversed forms itself; leave it False")
-        return map_best_surfaces(s1, s2, mesh_size=mesh_size, skip_below=skip_below, workers=workers)
+        return map_best_surfaces(s1, s2, mesh_size=mesh_size, repeatable=repeatable, skip_below=skip_below,
+                                 workers=workers)
     if skip_below is not None or workers is not None:
         raise ValueError("skip_below/workers: only for method 'best'")
     prepared = isinstance(s1, PreparedSurface) and isinstance(s2, PreparedSurface)
@@ -189,12 +193,14 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None, skip
         v1, f1 = as_surface(s1, "s1", core_checks=True)
         v2, f2 = as_surface(s2, "s2", core_checks=True)
     size = as_real(mesh_size, "mesh_size", 0.0)
+    repeat = as_flag(repeatable, "repeatable")
     bar = StageBar(progress, "map_surfaces", _STAGES.get(method, ()))
     try:
         if prepared:
-            record = _core.map_prepared_surfaces(s1._prepared, s2._prepared, method, reverse, size, bar.callback)
+            record = _core.map_prepared_surfaces(s1._prepared, s2._prepared, method, reverse, size, repeat,
+                                                 bar.callback)
         else:
-            record = _core.map_surfaces(v1, f1, v2, f2, method, reverse, size, bar.callback)
+            record = _core.map_surfaces(v1, f1, v2, f2, method, reverse, size, repeat, bar.callback)
     finally:
         bar.close()
     return DisplacementField._from_core(record)

@@ -1,22 +1,29 @@
 // The child-process guard around Mesh_3 (an internal of the core, tested through its header): a
 // mesh comes back intact, the core's exceptions come back as themselves, and a crash in the child
-// becomes MesherCrashed while this process carries on.
+// becomes MesherCrashed while this process carries on. A threaded child gets TBB workers of its
+// own after this process has used TBB, one thread while another thread is in TBB, and a child
+// that stops using the CPU is replaced by one on one thread.
 #include "diffusion/mesh_in_child.hpp"
 
 #include <morphomap/errors.hpp>
 
 #include "check.hpp"
 
+#include <oneapi/tbb/parallel_for.h>
 #include <pthread.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <mutex>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
 
 using morphomap::detail::mesh_in_child;
+using morphomap::detail::mesh_in_child_threaded;
 using morphomap::detail::ShellMesh;
 
 namespace {
@@ -78,6 +85,62 @@ void a_crash_is_an_error() {
   round_trip();  // and the guard still works afterwards
 }
 
+// How many threads a TBB loop of about half a second's work ran on.
+int tbb_threads() {
+  std::set<std::thread::id> ids;
+  std::mutex guard;
+  oneapi::tbb::parallel_for(0, 400, [&](int) {
+    volatile double sum = 0.0;
+    for (int k = 0; k < 300000; ++k) sum = sum + k;
+    const std::lock_guard<std::mutex> lock(guard);
+    ids.insert(std::this_thread::get_id());
+  });
+  return static_cast<int>(ids.size());
+}
+
+// The child reports its thread count as the mesh's one vertex.
+ShellMesh threads_seen(bool threads) {
+  ShellMesh mesh = one_tetrahedron();
+  mesh.vertices(0, 0) = threads;
+  mesh.vertices(0, 1) = tbb_threads();
+  return mesh;
+}
+
+void a_threaded_child_has_workers() {
+  const int here = tbb_threads();  // this process's workers exist now
+  if (std::thread::hardware_concurrency() < 2 || here < 2) return;
+  const ShellMesh got = mesh_in_child_threaded(threads_seen, "test");
+  CHECK(got.vertices(0, 0) == 1.0);
+  CHECK(got.vertices(0, 1) >= 2.0);
+  CHECK(tbb_threads() >= 2);  // and this process has its workers back
+}
+
+void another_thread_in_tbb_means_one_thread() {
+  std::atomic<bool> stop{false};
+  std::thread busy([&] {
+    while (!stop) tbb_threads();
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  const ShellMesh got = mesh_in_child_threaded(threads_seen, "test");
+  stop = true;
+  busy.join();
+  // Told to use one thread, the child's TBB has no workers of its own.
+  if (got.vertices(0, 0) == 0.0) CHECK(got.vertices(0, 1) == 1.0);
+}
+
+void a_stalled_child_is_replaced() {
+  const auto start = std::chrono::steady_clock::now();
+  const ShellMesh got = mesh_in_child_threaded(
+      [](bool threads) {
+        if (threads) ::pause();  // waits for a signal: no CPU time, as a child stuck on a lock
+        return one_tetrahedron();
+      },
+      "test", 0.5);
+  CHECK(got.tetrahedra == one_tetrahedron().tetrahedra);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  CHECK(seconds > 0.5 && seconds < 5.0);
+}
+
 // Threads that mesh at once fork one at a time: a library's fork handlers (OpenBLAS's joins its
 // threads) may not run twice at once. A prepare handler of our own sees whether two forks overlap;
 // its pause makes an overlap near certain if the guard lets forks run together.
@@ -96,8 +159,11 @@ void forks_are_serialized() {
   std::vector<std::thread> threads;
   for (int t = 0; t < 4; ++t) {
     threads.emplace_back([&, t] {
-      for (int k = 0; k < 5; ++k)
-        intact[t] += mesh_in_child([&] { return sent; }, "test").tetrahedra == sent.tetrahedra;
+      for (int k = 0; k < 5; ++k) {  // the threaded guard stops TBB and forks under the same lock
+        const ShellMesh got = k % 2 ? mesh_in_child([&] { return sent; }, "test")
+                                    : mesh_in_child_threaded([&](bool) { return sent; }, "test");
+        intact[t] += got.tetrahedra == sent.tetrahedra;
+      }
     });
   }
   for (auto& thread : threads) thread.join();
@@ -111,6 +177,9 @@ int main() {
   round_trip();
   exceptions_come_back();
   a_crash_is_an_error();
+  a_threaded_child_has_workers();
+  another_thread_in_tbb_means_one_thread();
+  a_stalled_child_is_replaced();
   forks_are_serialized();
   TEST_MAIN_END();
 }

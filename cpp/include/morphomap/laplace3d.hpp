@@ -13,6 +13,11 @@ struct ShellDiffusionOptions {
   // its mean edge length (or mesh_size, if smaller) and grows away from it by a tenth of the
   // distance.
   double mesh_size = 0.0;
+  // true: the same input gives the same mesh, potential and ends, bit for bit, in any process and
+  // on any number of threads (Mesh_3 on one core). false: Mesh_3's parallel mode on all cores,
+  // faster, but the mesh (and so the ends, within the discretisation error) differs from run to
+  // run. Surfaces that cross always mesh repeatably.
+  bool repeatable = true;
   bool keep_streamlines = false;
   // Called with "mesh", "solve" and "trace" as each stage begins, on the calling thread (a
   // progress report); may be empty.

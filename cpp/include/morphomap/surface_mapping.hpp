@@ -29,6 +29,7 @@ struct SurfaceMappingOptions {
   MapMethod method = MapMethod::normal;
   bool reverse = false;              // map S2 -> S1 and flip: starts on S1, ends on S2, rows and faces of S2
   double diffusion_mesh_size = 0.0;  // ShellDiffusionOptions::mesh_size (0: automatic)
+  bool diffusion_repeatable = true;  // ShellDiffusionOptions::repeatable
   // Called with the name of each stage as it begins, on the calling thread (a progress report);
   // may be empty. diffusion: "mesh", "solve", "trace" (ShellDiffusionOptions::on_stage).
   // automatic: "normal", then, if it falls back, those three for each diffusion it tries (reverse,

@@ -40,6 +40,7 @@ using Vec4 = Eigen::Vector4d;
 constexpr double kSourceFraction = 0.02;
 constexpr double kFinestFraction = 0.01;
 constexpr int kMeshAttempts = 3;
+constexpr const char* kMeshing = "meshing the region between the surfaces";
 constexpr double kFacetDistanceNested = 0.2;
 constexpr double kFacetDistanceCrossing = 0.05;
 // Surfaces closer than this fraction of their finer mean edge touch (as 2D's contact tolerance).
@@ -464,6 +465,7 @@ ShellDiffusionSolution detail::solve_diffusion_3d(const ShellPair& pair, const S
   criteria.target_size = std::min(std::max(target.mean_edge, kFinestFraction * target_diagonal), criteria.cell_size);
   criteria.grading = 0.1;
   criteria.exude = true;
+  criteria.parallel = !options.repeatable && !crossing;
   // Between nested surfaces the boundary facets may stray a fifth of the element size from the
   // surfaces: at 0.05 Mesh_3 chased every crease of an unsmoothed marching-cubes surface (fuzz
   // seed 1882337550, a 2k-vertex swell pair: 917k tetrahedra, 128 s; at 0.2: 265k, 15 s), while
@@ -486,13 +488,15 @@ ShellDiffusionSolution detail::solve_diffusion_3d(const ShellPair& pair, const S
     criteria.target_size = finer * requested.target_size;
     criteria.facet_distance = finer * requested.facet_distance;
     try {
-      mesh = detail::mesh_in_child(
-          [&] {
-            return crossing ? crossing->mesh(criteria)
-                            : detail::mesh_shell(source_surface, target_surface,
-                                                 nesting == detail::Nesting::source_inside, criteria);
-          },
-          "meshing the region between the surfaces");
+      const auto make = [&](bool threads) {
+        detail::ShellMeshCriteria used = criteria;
+        used.parallel = criteria.parallel && threads;
+        return crossing ? crossing->mesh(used)
+                        : detail::mesh_shell(source_surface, target_surface,
+                                             nesting == detail::Nesting::source_inside, used);
+      };
+      mesh = criteria.parallel ? detail::mesh_in_child_threaded(make, kMeshing)
+                               : detail::mesh_in_child([&] { return make(false); }, kMeshing);
       break;
     } catch (const detail::MesherCrashed& crash) {
       if (attempt + 1 == kMeshAttempts) {

@@ -7,10 +7,18 @@
 
 #include <morphomap/errors.hpp>
 
+#include <oneapi/tbb/global_control.h>
+
 #include <cerrno>
+#include <chrono>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <mutex>
+#include <new>
+#include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -27,6 +35,10 @@ namespace morphomap::detail {
 #ifndef MORPHOMAP_HAVE_FORK
 
 ShellMesh mesh_in_child(const std::function<ShellMesh()>& make, const char*) { return make(); }
+
+ShellMesh mesh_in_child_threaded(const std::function<ShellMesh(bool threads)>& make, const char*, double) {
+  return make(true);
+}
 
 #else
 
@@ -159,39 +171,76 @@ struct Child {
   }
 };
 
+// CPU seconds the process has used (user and system), or -1 where /proc cannot tell.
+double cpu_seconds(pid_t pid) {
+  std::ifstream file("/proc/" + std::to_string(pid) + "/stat");
+  std::string stat;
+  if (!std::getline(file, stat)) return -1.0;
+  // The command name (field 2) is in parentheses and may hold spaces: count from the last one.
+  std::istringstream fields(stat.substr(stat.rfind(')') + 1));
+  std::string field;
+  long long ticks = 0;
+  for (int k = 3; k <= 15 && fields >> field; ++k) {
+    if (k >= 14) ticks += std::atoll(field.c_str());  // utime, stime
+  }
+  return static_cast<double>(ticks) / static_cast<double>(::sysconf(_SC_CLK_TCK));
+}
+
 // fork(), one thread at a time in this process. fork() runs every library's prepare handler in the
 // forking thread, and some are not safe to run twice at once: OpenBLAS's (loaded with SciPy) joins
 // its worker threads, and two concurrent forks joined the same thread, so one waited forever
-// (three Python threads meshing at once hung in about one run in two).
-pid_t fork_one_at_a_time() {
+// (three Python threads meshing at once hung in about one run in two). With stop_tbb, this
+// process's TBB workers are stopped first, so that the child can start its own; tbb_stopped says
+// whether they were (tbb::finalize refuses while another thread is in TBB).
+pid_t fork_one_at_a_time(bool stop_tbb, bool& tbb_stopped) {
   static std::mutex forking;
   const std::lock_guard<std::mutex> lock(forking);
+  tbb_stopped = false;
+  if (stop_tbb) {
+    oneapi::tbb::task_scheduler_handle workers{oneapi::tbb::attach{}};
+    tbb_stopped = oneapi::tbb::finalize(workers, std::nothrow);
+  }
   return ::fork();
 }
 
-}  // namespace
-
-ShellMesh mesh_in_child(const std::function<ShellMesh()>& make, const char* what) {
+// want_threads: `make` may run TBB work (see mesh_in_child_threaded). No mesh: a threaded child
+// stopped using the CPU for stall_seconds and was killed.
+std::optional<ShellMesh> fork_and_mesh(const std::function<ShellMesh(bool threads)>& make, const char* what,
+                                       bool want_threads, double stall_seconds) {
   int fds[2];
-  if (::pipe(fds) != 0) return make();  // no pipe to spare: mesh here
-  const pid_t pid = fork_one_at_a_time();
-  if (pid < 0) {
+  if (::pipe(fds) != 0) return make(want_threads);  // no pipe to spare: mesh here
+  bool threads = false;
+  const pid_t pid = fork_one_at_a_time(want_threads, threads);
+  if (pid < 0) {  // no process to spare: mesh here, where TBB starts its workers again
     ::close(fds[0]);
     ::close(fds[1]);
-    return make();
+    return make(want_threads);
   }
   if (pid == 0) {
     ::close(fds[0]);
-    run_child(fds[1], make);
+    run_child(fds[1], [&] { return make(threads); });
   }
   ::close(fds[1]);
   Child child{pid};
   std::vector<char> bytes;
   char buffer[1 << 16];
+  double cpu = threads ? cpu_seconds(pid) : -1.0;
+  auto cpu_moved = std::chrono::steady_clock::now();
   for (;;) {
     pollfd ready{fds[0], POLLIN, 0};
     const int polled = ::poll(&ready, 1, 100);
     if (polled < 0 && errno != EINTR) break;
+    if (cpu >= 0.0) {
+      const double now_cpu = cpu_seconds(pid);
+      const auto now = std::chrono::steady_clock::now();
+      if (now_cpu != cpu) {
+        cpu = now_cpu;
+        cpu_moved = now;
+      } else if (std::chrono::duration<double>(now - cpu_moved).count() > stall_seconds) {
+        ::close(fds[0]);
+        return std::nullopt;  // (child's destructor kills it)
+      }
+    }
     if (polled <= 0) {
       try {
         check_interrupt();
@@ -217,6 +266,18 @@ ShellMesh mesh_in_child(const std::function<ShellMesh()>& make, const char* what
   }
   if (bytes.empty()) throw GeometryError(std::string(what) + ": the meshing process ended without an answer");
   return decode(bytes);
+}
+
+}  // namespace
+
+ShellMesh mesh_in_child(const std::function<ShellMesh()>& make, const char* what) {
+  return *fork_and_mesh([&](bool) { return make(); }, what, false, 0.0);
+}
+
+ShellMesh mesh_in_child_threaded(const std::function<ShellMesh(bool threads)>& make, const char* what,
+                                 double stall_seconds) {
+  if (auto mesh = fork_and_mesh(make, what, true, stall_seconds)) return std::move(*mesh);
+  return *fork_and_mesh(make, what, false, 0.0);
 }
 
 #endif

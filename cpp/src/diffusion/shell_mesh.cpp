@@ -12,24 +12,24 @@
 #include <CGAL/Mesh_complex_3_in_triangulation_3.h>
 #include <CGAL/Mesh_criteria_3.h>
 #include <CGAL/Mesh_triangulation_3.h>
-#include <CGAL/Orthogonal_k_neighbor_search.h>
 #include <CGAL/Polygon_mesh_processing/connected_components.h>
 #include <CGAL/Polygon_mesh_processing/corefinement.h>
 #include <CGAL/Polygon_mesh_processing/intersection.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Polyhedral_complex_mesh_domain_3.h>
 #include <CGAL/Random.h>
-#include <CGAL/Search_traits_3.h>
 #include <CGAL/Side_of_triangle_mesh.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/boost/graph/properties_Surface_mesh_features.h>
 #include <CGAL/make_mesh_3.h>
 #include <CGAL/refine_mesh_3.h>
 #include <boost/iterator/indirect_iterator.hpp>
+#include <nanoflann.hpp>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <unordered_map>
@@ -42,45 +42,91 @@ namespace {
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Point = Kernel::Point_3;
 using Domain = CGAL::Polyhedral_complex_mesh_domain_3<Kernel, SurfaceMesh>;
-using Triangulation = CGAL::Mesh_triangulation_3<Domain, CGAL::Default, CGAL::Sequential_tag>::type;
-using C3t3 = CGAL::Mesh_complex_3_in_triangulation_3<Triangulation, Domain::Corner_index, Domain::Curve_index>;
-using Criteria = CGAL::Mesh_criteria_3<Triangulation>;
+// Mesh_3's types, sequential (repeatable) or parallel (TBB: faster, but the insertion order
+// follows the threads, so the mesh differs from run to run).
+template <class Concurrency>
+struct Mesh3 {
+  using Triangulation = typename CGAL::Mesh_triangulation_3<Domain, CGAL::Default, Concurrency>::type;
+  using C3t3 = CGAL::Mesh_complex_3_in_triangulation_3<Triangulation, Domain::Corner_index, Domain::Curve_index>;
+  using Criteria = CGAL::Mesh_criteria_3<Triangulation>;
+};
+using C3t3 = Mesh3<CGAL::Sequential_tag>::C3t3;
+using Criteria = Mesh3<CGAL::Sequential_tag>::Criteria;
 
-using SearchTraits = CGAL::Search_traits_3<Kernel>;
-using Neighbour = CGAL::Orthogonal_k_neighbor_search<SearchTraits>;
-using PointTree = Neighbour::Tree;
+// The distance from a point to the nearest vertex of a surface. nanoflann's k-d tree, not CGAL's
+// Orthogonal_k_neighbor_search: Mesh_3 asks millions of times, and CGAL's search (a priority
+// queue allocated per query) was 30% of the meshing's CPU time (bench/README.md). Both are
+// exact and sum the squared coordinate differences in the same order: the same distances.
+class NearestVertex {
+ public:
+  // (The tree indexes the points when it is made: cloud_ is declared first.)
+  explicit NearestVertex(const SurfaceMesh& surface) : cloud_{points_of(surface)}, tree_(3, cloud_) {}
+  NearestVertex(const NearestVertex&) = delete;  // the tree refers to cloud_
+  NearestVertex& operator=(const NearestVertex&) = delete;
+
+  double distance(const Point& p) const {
+    const double query[3] = {p.x(), p.y(), p.z()};
+    std::uint32_t index = 0;
+    double squared = 0.0;
+    tree_.knnSearch(query, 1, &index, &squared);
+    return std::sqrt(squared);
+  }
+
+ private:
+  // nanoflann's dataset interface.
+  struct Cloud {
+    std::vector<std::array<double, 3>> points;
+    std::size_t kdtree_get_point_count() const { return points.size(); }
+    double kdtree_get_pt(std::size_t i, std::size_t axis) const { return points[i][axis]; }
+    template <class Box>
+    bool kdtree_get_bbox(Box&) const {
+      return false;
+    }
+  };
+  static std::vector<std::array<double, 3>> points_of(const SurfaceMesh& surface) {
+    std::vector<std::array<double, 3>> points;
+    points.reserve(surface.number_of_vertices());
+    for (const auto v : surface.vertices()) {
+      const Point& p = surface.point(v);
+      points.push_back({p.x(), p.y(), p.z()});
+    }
+    return points;
+  }
+  using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>, Cloud, 3>;
+
+  Cloud cloud_;
+  Tree tree_;
+};
 
 // Target edge length at a point: graded from the size at each surface with the distance to it,
 // the distance estimated by the nearest surface vertex (cheap: Mesh_3 asks very often). Mesh_3
-// copies its sizing fields: the trees are shared.
+// copies its sizing fields: the trees are shared (and only read, also by the parallel mesher).
 class Sizing {
  public:
   Sizing(const SurfaceMesh& source, const SurfaceMesh& target, const ShellMeshCriteria& criteria)
-      : source_(std::make_shared<PointTree>(source.points().begin(), source.points().end())),
-        target_(std::make_shared<PointTree>(target.points().begin(), target.points().end())),
-        criteria_(criteria) {
-    source_->build();
-    target_->build();
-  }
+      : source_(std::make_shared<const NearestVertex>(source)),
+        target_(std::make_shared<const NearestVertex>(target)),
+        criteria_(criteria) {}
 
   template <typename Index_>
   double operator()(const Point& p, int, const Index_&) const {
-    const double ds = std::sqrt(Neighbour(*source_, p, 1).begin()->second);
+    const double ds = source_->distance(p);
     const double size = std::min(criteria_.cell_size, criteria_.source_size + criteria_.grading * ds);
-    // The nearest-vertex searches are a fifth of the meshing time: skip the second where it
-    // cannot give less.
+    // Skip the second search where it cannot give less.
     if (size <= criteria_.target_size) return size;
-    const double dt = std::sqrt(Neighbour(*target_, p, 1).begin()->second);
+    const double dt = target_->distance(p);
     return std::min(size, criteria_.target_size + criteria_.grading * dt);
   }
 
  private:
-  std::shared_ptr<PointTree> source_, target_;
+  std::shared_ptr<const NearestVertex> source_, target_;
   ShellMeshCriteria criteria_;
 };
 
 // A few vertices of a surface (every n/20-th) inserted as points of its patch.
-void seed_patch(C3t3& c3t3, const Domain& domain, const SurfaceMesh& surface, int patch) {
+template <class Complex>
+void seed_patch(Complex& c3t3, const Domain& domain, const SurfaceMesh& surface, int patch) {
+  using Triangulation = typename Complex::Triangulation;
   Triangulation& tr = c3t3.triangulation();
   const auto weighted = tr.geom_traits().construct_weighted_point_3_object();
   const std::size_t n = surface.number_of_vertices(), stride = std::max<std::size_t>(1, n / 20);
@@ -88,7 +134,7 @@ void seed_patch(C3t3& c3t3, const Domain& domain, const SurfaceMesh& surface, in
   for (const auto v : surface.vertices()) {
     if (k++ % stride != 0) continue;
     const auto handle = tr.insert(weighted(surface.point(v)));
-    if (handle == Triangulation::Vertex_handle()) continue;
+    if (handle == typename Triangulation::Vertex_handle()) continue;
     c3t3.set_dimension(handle, 2);
     c3t3.set_index(handle, domain.index_from_surface_patch_index(patch));
   }
@@ -102,7 +148,8 @@ void seed_patch(C3t3& c3t3, const Domain& domain, const SurfaceMesh& surface, in
 // meshing for no better ends; at 30 degrees the ends are as good as before (bench/README.md).
 constexpr double kSliverBound = 30.0;
 
-void refine(C3t3& c3t3, const Domain& domain, const Criteria& criteria, bool exude) {
+template <class Complex, class MeshCriteria>
+void refine(Complex& c3t3, const Domain& domain, const MeshCriteria& criteria, bool exude) {
   namespace params = CGAL::parameters;
   if (exude) {
     CGAL::refine_mesh_3(c3t3, domain, criteria, params::no_perturb(),
@@ -114,12 +161,13 @@ void refine(C3t3& c3t3, const Domain& domain, const Criteria& criteria, bool exu
 
 // The tetrahedra of the complex, with their neighbours and the kind of each boundary face:
 // patch_kind(patch index) -> FacePatch.
-template <class PatchKind>
-ShellMesh to_shell_mesh(const C3t3& c3t3, PatchKind patch_kind) {
+template <class Complex, class PatchKind>
+ShellMesh to_shell_mesh(const Complex& c3t3, PatchKind patch_kind) {
+  using Triangulation = typename Complex::Triangulation;
   ShellMesh mesh;
   const Triangulation& tr = c3t3.triangulation();
-  std::unordered_map<Triangulation::Cell_handle, Index> cell_index;
-  std::unordered_map<Triangulation::Vertex_handle, Index> vertex_index;
+  std::unordered_map<typename Triangulation::Cell_handle, Index> cell_index;
+  std::unordered_map<typename Triangulation::Vertex_handle, Index> vertex_index;
   Index cells = 0;
   for (auto c = c3t3.cells_in_complex_begin(); c != c3t3.cells_in_complex_end(); ++c) {
     cell_index[c] = cells++;
@@ -206,9 +254,12 @@ std::vector<char> inside_surface(const ClosedSurface& surface, const Points3Ref&
   return inside;
 }
 
-ShellMesh mesh_shell(const ClosedSurface& source, const ClosedSurface& target, bool source_inside,
-                     const ShellMeshCriteria& criteria) {
-  C3t3 c3t3;
+namespace {
+
+template <class Concurrency>
+ShellMesh mesh_nested(const ClosedSurface& source, const ClosedSurface& target, bool source_inside,
+                      const ShellMeshCriteria& criteria) {
+  typename Mesh3<Concurrency>::C3t3 c3t3;
   try {
     const SurfaceMesh* patches[2] = {&source.mesh().surface, &target.mesh().surface};
     // (subdomain inside, subdomain outside) of each outward-oriented patch; the shell is 1.
@@ -220,9 +271,9 @@ ShellMesh mesh_shell(const ClosedSurface& source, const ClosedSurface& target, b
     const Domain domain(boost::make_indirect_iterator(patches), boost::make_indirect_iterator(patches + 2), sides,
                         sides + 2, &random);
     namespace params = CGAL::parameters;
-    const Criteria mesh_criteria(params::facet_angle = 25.0, params::facet_size = sizing,
-                                 params::facet_distance = criteria.facet_distance, params::cell_radius_edge_ratio = 3.0,
-                                 params::cell_size = sizing);
+    const typename Mesh3<Concurrency>::Criteria mesh_criteria(params::facet_angle = 25.0, params::facet_size = sizing,
+                                                        params::facet_distance = criteria.facet_distance, params::cell_radius_edge_ratio = 3.0,
+                                                        params::cell_size = sizing);
     // Mesh_3's own initial points come from rays shot from the centre of the bounding box and may
     // all land on the outer surface, so that the inner one is never found: start instead from a
     // few vertices of each surface, as points of its patch.
@@ -237,6 +288,14 @@ ShellMesh mesh_shell(const ClosedSurface& source, const ClosedSurface& target, b
   return to_shell_mesh(c3t3, [](int patch) {
     return patch == 1 ? source_face : patch == 2 ? target_face : other_face;
   });
+}
+
+}  // namespace
+
+ShellMesh mesh_shell(const ClosedSurface& source, const ClosedSurface& target, bool source_inside,
+                     const ShellMeshCriteria& criteria) {
+  return criteria.parallel ? mesh_nested<CGAL::Parallel_tag>(source, target, source_inside, criteria)
+                           : mesh_nested<CGAL::Sequential_tag>(source, target, source_inside, criteria);
 }
 
 // Each patch: a connected piece of one surface between the curves where the surfaces cross,

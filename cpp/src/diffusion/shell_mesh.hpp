@@ -57,6 +57,9 @@ struct ShellMeshCriteria {
   double facet_distance = 0.0;  // largest distance between the mesh boundary and the surfaces
   bool exude = true;            // remove slivers after refinement
   int seed = 0;                 // of the mesher's random choices (another seed, another mesh)
+  // Mesh_3's parallel mode on all cores (nested surfaces only; crossing ones mesh sequentially):
+  // faster, but the mesh differs from run to run.
+  bool parallel = false;
 };
 
 enum FacePatch : signed char { interior_face = 0, source_face = 1, target_face = 2, other_face = -1 };

@@ -196,6 +196,7 @@ DisplacementField3 checked(Surface s1, Surface s2, const SurfaceMappingOptions& 
   }
   ShellDiffusionOptions diffusion;
   diffusion.mesh_size = options.diffusion_mesh_size;
+  diffusion.repeatable = options.diffusion_repeatable;
   diffusion.on_stage = options.on_stage;
   const Pair pair{s1, s2, nesting};
   if (!options.reverse) return directed(options.method, pair, diffusion);
