@@ -342,7 +342,8 @@ def test_meshing_on_all_cores_beside_other_threads_neither_hangs_nor_loses_point
     import subprocess
     import sys
 
-    run = subprocess.run([sys.executable, "-c", _PARALLEL_BESIDE_THREADS_SCRIPT], capture_output=True, text=True, timeout=300)
+    run = subprocess.run([sys.executable, "-c", _PARALLEL_BESIDE_THREADS_SCRIPT], capture_output=True, text=True,
+                         timeout=300)
     assert run.returncode == 0, run.stderr[-2000:]
     assert run.stdout.split() == ["6", "0"], run.stdout
 

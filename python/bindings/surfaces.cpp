@@ -118,8 +118,8 @@ void bind_surfaces(py::module_& m) {
         }
         return field_record(std::move(field));
       },
-      py::arg("s1"), py::arg("s2"), py::arg("method"), py::arg("reverse"), py::arg("mesh_size"),
-      py::arg("repeatable"), py::arg("on_stage") = py::none());
+      py::arg("s1"), py::arg("s2"), py::arg("method"), py::arg("reverse"), py::arg("mesh_size"), py::arg("repeatable"),
+      py::arg("on_stage") = py::none());
   m.def(
       "prepared_surface_quality",
       [](const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, const PreparedSurface& s1,

@@ -492,8 +492,8 @@ ShellDiffusionSolution detail::solve_diffusion_3d(const ShellPair& pair, const S
         detail::ShellMeshCriteria used = criteria;
         used.parallel = criteria.parallel && threads;
         return crossing ? crossing->mesh(used)
-                        : detail::mesh_shell(source_surface, target_surface,
-                                             nesting == detail::Nesting::source_inside, used);
+                        : detail::mesh_shell(source_surface, target_surface, nesting == detail::Nesting::source_inside,
+                                             used);
       };
       mesh = criteria.parallel ? detail::mesh_in_child_threaded(make, kMeshing)
                                : detail::mesh_in_child([&] { return make(false); }, kMeshing);
