@@ -271,32 +271,43 @@ def test_same_input_same_mesh_and_field_in_other_processes_and_thread_counts():
 
 
 _THREADS_SCRIPT = """
-import hashlib, threading
+import hashlib, sys, threading
 import numpy as np, scipy.linalg, trimesh  # SciPy's OpenBLAS brings a fork handler of its own
 import morphomap as mm
-a = trimesh.creation.icosphere(2)
+repeatable = sys.argv[1] == "repeatable"
+a = trimesh.creation.icosphere(2 if repeatable else 3)
 s1 = (np.array(a.vertices), np.array(a.faces))
 s2 = (np.array(a.vertices) * [2.0, 1.5, 1.2], np.array(a.faces))
-digests = []
+digests, lost = [], []
 def diffusion():
-    for _ in range(4):
-        digests.append(hashlib.sha256(mm.solve_diffusion_3d(s1, s2, mesh_size=0.5).ends.tobytes()).hexdigest())
-threads = [threading.Thread(target=diffusion) for _ in range(3)]
+    for _ in range(4 if repeatable else 3):
+        ends = mm.solve_diffusion_3d(s1, s2, mesh_size=0.5 if repeatable else None, repeatable=repeatable).ends
+        digests.append(hashlib.sha256(ends.tobytes()).hexdigest())
+        lost.append(int((~np.isfinite(ends)).sum()))
+def normals():  # TBB and Embree work in this process while the meshers fork
+    for _ in range(40):
+        mm.map_surfaces(s1, s2, "normal")
+threads = [threading.Thread(target=f) for f in ([diffusion] * 3 if repeatable else [diffusion, diffusion, normals])]
 for t in threads: t.start()
 for t in threads: t.join()
-print(len(digests), len(set(digests)))
+print(len(digests), len(set(digests)), sum(lost))
 """
+
+
+def run_threads_script(mode):
+    """(diffusions, distinct fields, lost points) of _THREADS_SCRIPT in a child process."""
+    import subprocess
+    import sys
+
+    run = subprocess.run([sys.executable, "-c", _THREADS_SCRIPT, mode], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr[-2000:]
+    return [int(word) for word in run.stdout.split()]
 
 
 def test_threads_meshing_at_once_neither_hang_nor_differ():
     # Each mesh is made in a forked child. Two threads forking at once ran OpenBLAS's fork handler
     # twice at once, and it joined one of its threads twice: the process hung (about one run in two).
-    import subprocess
-    import sys
-
-    run = subprocess.run([sys.executable, "-c", _THREADS_SCRIPT], capture_output=True, text=True, timeout=300)
-    assert run.returncode == 0, run.stderr[-2000:]
-    assert run.stdout.split() == ["12", "1"], run.stdout
+    assert run_threads_script("repeatable") == [12, 1, 0]
 
 
 def test_meshing_on_all_cores_is_as_accurate():
@@ -315,37 +326,11 @@ def test_meshing_on_all_cores_is_as_accurate():
     assert mapped.valid.all() and mm.quality(mapped, sphere(1.0, 3), ellipsoid).folds == 0
 
 
-_PARALLEL_BESIDE_THREADS_SCRIPT = """
-import threading
-import numpy as np, scipy.linalg, trimesh
-import morphomap as mm
-a = trimesh.creation.icosphere(3)
-s1 = (np.array(a.vertices), np.array(a.faces))
-s2 = (np.array(a.vertices) * [2.0, 1.5, 1.2], np.array(a.faces))
-lost = []
-def diffusion():
-    for _ in range(3):
-        lost.append(int((~np.isfinite(mm.solve_diffusion_3d(s1, s2, repeatable=False).ends)).sum()))
-def normals():  # TBB and Embree work in this process while the meshers fork
-    for _ in range(40):
-        mm.map_surfaces(s1, s2, "normal")
-threads = [threading.Thread(target=f) for f in (diffusion, diffusion, normals)]
-for t in threads: t.start()
-for t in threads: t.join()
-print(len(lost), sum(lost))
-"""
-
-
 def test_meshing_on_all_cores_beside_other_threads_neither_hangs_nor_loses_points():
     # Each fork stops this process's TBB workers first; a thread that enters TBB between that and
     # the fork could leave the child waiting on a lock: it is then replaced by a one-thread child.
-    import subprocess
-    import sys
-
-    run = subprocess.run([sys.executable, "-c", _PARALLEL_BESIDE_THREADS_SCRIPT], capture_output=True, text=True,
-                         timeout=300)
-    assert run.returncode == 0, run.stderr[-2000:]
-    assert run.stdout.split() == ["6", "0"], run.stdout
+    diffusions, _, lost = run_threads_script("all-cores")
+    assert (diffusions, lost) == (6, 0)
 
 
 def test_progress_reports_the_stages(capsys):
