@@ -56,9 +56,9 @@ using C3t3 = Mesh3<CGAL::Sequential_tag>::C3t3;
 using Criteria = Mesh3<CGAL::Sequential_tag>::Criteria;
 
 // The distance from a point to the nearest vertex of a surface. nanoflann's k-d tree, not CGAL's
-// Orthogonal_k_neighbor_search: Mesh_3 asks millions of times, and CGAL's search (a priority
-// queue allocated per query) was 30% of the meshing's CPU time (bench/README.md). Both are
-// exact and sum the squared coordinate differences in the same order: the same distances.
+// Orthogonal_k_neighbor_search (a priority queue allocated per query): the meshing took ~5% less
+// time at 100k faces (bench/README.md). Both are exact and sum the squared coordinate
+// differences in the same order: the same distances.
 class NearestVertex {
  public:
   // (The tree indexes the points when it is made: cloud_ is declared first.)
