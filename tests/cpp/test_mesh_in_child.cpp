@@ -116,16 +116,21 @@ void a_threaded_child_has_workers() {
 }
 
 void another_thread_in_tbb_means_one_thread() {
-  std::atomic<bool> stop{false};
+  // The other thread stays inside one TBB loop until the child has answered, so that
+  // tbb::finalize must refuse and the child must be told to use one thread.
+  std::atomic<bool> stop{false}, inside{false};
   std::thread busy([&] {
-    while (!stop) tbb_threads();
+    oneapi::tbb::parallel_for(0, 1, [&](int) {
+      inside = true;
+      while (!stop) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    });
   });
-  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  while (!inside) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   const ShellMesh got = mesh_in_child_threaded(threads_seen, "test");
   stop = true;
   busy.join();
-  // Told to use one thread, the child's TBB has no workers of its own.
-  if (got.vertices(0, 0) == 0.0) CHECK(got.vertices(0, 1) == 1.0);
+  CHECK(got.vertices(0, 0) == 0.0);  // told to use one thread
+  CHECK(got.vertices(0, 1) == 1.0);  // and its TBB had no workers of its own
 }
 
 void a_stalled_child_is_replaced() {
