@@ -175,6 +175,7 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None, repe
     """
     method = as_choice(method, "method", SURFACE_METHODS)
     reverse = as_flag(reverse, "reverse")
+    repeatable = as_flag(repeatable, "repeatable")  # before "best" runs its candidates
     progress = as_progress(progress)
     if method == "best":
         from .best import map_best_surfaces
@@ -193,14 +194,13 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None, repe
         v1, f1 = as_surface(s1, "s1", core_checks=True)
         v2, f2 = as_surface(s2, "s2", core_checks=True)
     size = as_real(mesh_size, "mesh_size", 0.0)
-    repeat = as_flag(repeatable, "repeatable")
     bar = StageBar(progress, "map_surfaces", _STAGES.get(method, ()))
     try:
         if prepared:
-            record = _core.map_prepared_surfaces(s1._prepared, s2._prepared, method, reverse, size, repeat,
+            record = _core.map_prepared_surfaces(s1._prepared, s2._prepared, method, reverse, size, repeatable,
                                                  bar.callback)
         else:
-            record = _core.map_surfaces(v1, f1, v2, f2, method, reverse, size, repeat, bar.callback)
+            record = _core.map_surfaces(v1, f1, v2, f2, method, reverse, size, repeatable, bar.callback)
     finally:
         bar.close()
     return DisplacementField._from_core(record)
