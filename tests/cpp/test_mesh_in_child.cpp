@@ -2,7 +2,8 @@
 // mesh comes back intact, the core's exceptions come back as themselves, and a crash in the child
 // becomes MesherCrashed while this process carries on. A threaded child gets TBB workers of its
 // own after this process has used TBB, one thread while another thread is in TBB, and a child
-// that stops using the CPU is replaced by one on one thread.
+// that stops using the CPU is replaced by one on one thread. A child does not outlive a parent
+// killed outright.
 #include "diffusion/mesh_in_child.hpp"
 
 #include <morphomap/errors.hpp>
@@ -11,11 +12,14 @@
 
 #include <oneapi/tbb/parallel_for.h>
 #include <pthread.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <fstream>
+#include <iterator>
 #include <mutex>
 #include <set>
 #include <string>
@@ -176,6 +180,52 @@ void forks_are_serialized() {
   for (const int count : intact) CHECK(count == 5);
 }
 
+// Whether process `pid` has ended (gone, or a zombie nobody has reaped yet).
+bool ended(pid_t pid) {
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  if (!stat) return true;
+  std::string text((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
+  const std::size_t close = text.rfind(')');
+  return close == std::string::npos || close + 2 >= text.size() || text[close + 2] == 'Z' || text[close + 2] == 'X';
+}
+
+// A process meshing in a child is killed outright (SIGKILL, as a harness's timeout does): its child
+// must not mesh on alone. (It used to: orphaned mesher children of killed fuzz workers kept both
+// cores busy for minutes.)
+void a_child_dies_with_its_parent() {
+  int fds[2];
+  CHECK(::pipe(fds) == 0);
+  const pid_t middle = ::fork();
+  if (middle == 0) {
+    ::close(fds[0]);
+    try {
+      mesh_in_child(
+          [&] {
+            const pid_t me = ::getpid();
+            CHECK(::write(fds[1], &me, sizeof me) == static_cast<ssize_t>(sizeof me));
+            for (;;) ::pause();  // a mesher that never finishes
+            return one_tetrahedron();
+          },
+          "test");
+    } catch (...) {
+    }
+    ::_exit(0);
+  }
+  ::close(fds[1]);
+  pid_t meshing = 0;
+  CHECK(::read(fds[0], &meshing, sizeof meshing) == static_cast<ssize_t>(sizeof meshing));
+  ::close(fds[0]);
+  ::kill(middle, SIGKILL);
+  ::waitpid(middle, nullptr, 0);
+  bool gone = false;
+  for (int k = 0; k < 250 && !gone; ++k) {
+    gone = ended(meshing);
+    if (!gone) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  CHECK(gone);
+  if (!gone) ::kill(meshing, SIGKILL);
+}
+
 }  // namespace
 
 int main() {
@@ -185,6 +235,7 @@ int main() {
   a_threaded_child_has_workers();
   another_thread_in_tbb_means_one_thread();
   a_stalled_child_is_replaced();
+  a_child_dies_with_its_parent();
   forks_are_serialized();
   TEST_MAIN_END();
 }

@@ -25,6 +25,9 @@
 #if defined(__unix__) || defined(__APPLE__)
 #include <poll.h>
 #include <signal.h>
+#if defined(__linux__)
+#include <sys/prctl.h>
+#endif
 #include <sys/wait.h>
 #include <unistd.h>
 #define MORPHOMAP_HAVE_FORK 1
@@ -82,11 +85,21 @@ std::vector<char> encode(Status status, const std::string& message) {
   return out;
 }
 
-[[noreturn]] void run_child(int fd, const std::function<ShellMesh()>& make) {
+[[noreturn]] void run_child(int fd, pid_t parent, const std::function<ShellMesh()>& make) {
   // The parent's handlers (Python's faulthandler, say) would report the crash as the parent's
   // own; the parent reports it. Ctrl-C reaches the parent, which ends the child.
   for (const int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) ::signal(sig, SIG_DFL);
   ::signal(SIGINT, SIG_IGN);
+#if defined(__linux__)
+  // A parent killed outright (SIGKILL, a test harness's timeout) cannot end its child: the child
+  // would mesh on alone, for minutes, on a core nobody waits for. The kernel ends it instead (the
+  // forking thread waits for the child, so it outlives it unless the process dies); a parent
+  // already gone before this line is caught by the second test.
+  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (::getppid() != parent) ::_exit(1);
+#else
+  (void)parent;
+#endif
   std::vector<char> reply;
   try {
     reply = encode(make());
@@ -210,6 +223,7 @@ std::optional<ShellMesh> fork_and_mesh(const std::function<ShellMesh(bool thread
   int fds[2];
   if (::pipe(fds) != 0) return make(want_threads);  // no pipe to spare: mesh here
   bool threads = false;
+  const pid_t parent = ::getpid();
   const pid_t pid = fork_one_at_a_time(want_threads, threads);
   if (pid < 0) {  // no process to spare: mesh here, where TBB starts its workers again
     ::close(fds[0]);
@@ -218,7 +232,7 @@ std::optional<ShellMesh> fork_and_mesh(const std::function<ShellMesh(bool thread
   }
   if (pid == 0) {
     ::close(fds[0]);
-    run_child(fds[1], [&] { return make(threads); });
+    run_child(fds[1], parent, [&] { return make(threads); });
   }
   ::close(fds[1]);
   Child child{pid};
