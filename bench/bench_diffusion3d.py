@@ -17,6 +17,9 @@
    only, never a dependency) meshing the shell with quality switches, then scikit-fem's P1
    assembly. Each case runs in its own process; peak memory is the process's plus its children's
    (the mesher's) largest resident sets, an upper bound.
+5. A new bud (--bud): map_surfaces(..., "auto") on a lumpy pair of 100k faces where S2 grows one
+   bud over a narrow pit of S1, so that normal mapping folds around the pit only; the time of each
+   of auto's steps and the share of the surface that folds.
 
 --all-cores runs every table with repeatable=False (Mesh_3's parallel mode on all cores).
 """
@@ -161,6 +164,36 @@ def lumpy_nested_pair(faces):
     return (u * lumpy_radius(u, 1, 0.15)[:, None], triangles), (2.0 * u * lumpy_radius(u, 2, 0.15)[:, None], triangles)
 
 
+def bud_pair(faces):
+    """The lumpy inner surface of lumpy_nested_pair with a narrow pit; S2 = 1.15 x it, plus a bud over the pit."""
+    u, triangles = geodesic_sphere(int(np.sqrt(faces / 20) + 0.5))
+    lumpy = lumpy_radius(u, 1, 0.15)
+    axis = np.array([0.3, -0.5, 0.81])
+    angle = np.arccos(np.clip(u @ (axis / np.linalg.norm(axis)), -1, 1))
+    pit = 0.25 * np.exp(-0.5 * (angle / 0.06) ** 2)
+    bud = 0.6 * np.exp(-0.5 * (angle / 0.3) ** 2)
+    return (u * (lumpy - pit)[:, None], triangles), (u * (1.15 * lumpy + bud)[:, None], triangles)
+
+
+def bud_table(faces):
+    """auto on the bud pair, with the normal mapping and whole-surface diffusion it chooses between."""
+    (v1, f1), (v2, f2) = bud_pair(faces)
+    s1, s2 = trimesh.Trimesh(v1, f1, process=False), trimesh.Trimesh(v2, f2, process=False)
+    start = time.perf_counter()
+    normal = mm.map_surfaces(s1, s2, "normal")
+    normal_seconds = time.perf_counter() - start
+    folded = mm.quality(normal, s1, s2).folds
+    start = time.perf_counter()
+    auto = mm.map_surfaces(s1, s2, "auto", repeatable=REPEATABLE)
+    auto_seconds = time.perf_counter() - start
+    q = mm.quality(auto, s1, s2)
+    methods = ", ".join(sorted(map(str, set(auto.method))))
+    print(f"\n5. A new bud ({len(f1):,} faces per surface): normal mapping {normal_seconds:.1f} s, {folded:,} folded "
+          f"faces ({folded / len(f1):.1%} of the surface)")
+    print(f"   auto: {auto_seconds:.1f} s end to end, methods {methods}, {len(auto):,} vectors, {q.folds} folds, "
+          f"{int((~auto.valid).sum())} lost")
+
+
 def peak_memory_gb():
     """Largest resident sets of this process and of its children (the mesher), summed: GB."""
     kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss + resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
@@ -258,6 +291,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quick", action="store_true", help="default mesh sizes only")
     parser.add_argument("--organ", action="store_true", help="only the organ-scale table (4), ~10 min")
+    parser.add_argument("--bud", action="store_true", help="only the new-bud table (5)")
     parser.add_argument("--all-cores", action="store_true", help="repeatable=False: Mesh_3 on all cores")
     parser.add_argument("--case", nargs=2, metavar=("KIND", "FACES"), help=argparse.SUPPRESS)
     args = parser.parse_args()
@@ -266,6 +300,9 @@ def main():
     if args.case:
         kind, faces = args.case[0], int(args.case[1])
         print(json.dumps(organ_morphomap(faces) if kind == "morphomap" else organ_peer(faces)))
+        return
+    if args.bud:
+        bud_table(100_000)
         return
     if args.organ:
         organ_table([10_000, 20_000, 100_000, 200_000], {20_000, 100_000, 200_000})
