@@ -93,8 +93,8 @@ std::vector<char> encode(Status status, const std::string& message) {
 #if defined(__linux__)
   // A parent killed outright (SIGKILL, a test harness's timeout) cannot end its child: the child
   // would mesh on alone, for minutes, on a core nobody waits for. The kernel ends it instead (the
-  // forking thread waits for the child, so it outlives it unless the process dies); a parent
-  // already gone before this line is caught by the second test.
+  // forking thread waits for the child, so it outlives it unless the process dies). A parent that
+  // died before the request shows as a new parent process id.
   ::prctl(PR_SET_PDEATHSIG, SIGKILL);
   if (::getppid() != parent) ::_exit(1);
 #else
