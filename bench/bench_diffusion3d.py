@@ -18,8 +18,8 @@
    assembly. Each case runs in its own process; peak memory is the process's plus its children's
    (the mesher's) largest resident sets, an upper bound.
 5. A new bud (--bud): map_surfaces(..., "auto") on a lumpy pair of 100k faces where S2 grows one
-   bud over a narrow pit of S1, so that normal mapping folds around the pit only; the time of each
-   of auto's steps and the share of the surface that folds.
+   bud over a narrow pit of S1, so that normal mapping folds around the pit only: the share of the
+   surface that folds, the time of normal mapping and of auto end to end.
 
 --all-cores runs every table with repeatable=False (Mesh_3's parallel mode on all cores).
 """
@@ -176,7 +176,7 @@ def bud_pair(faces):
 
 
 def bud_table(faces):
-    """auto on the bud pair, with the normal mapping and whole-surface diffusion it chooses between."""
+    """Normal mapping on the bud pair (its folds), then auto, which starts with it and falls back where it folds."""
     (v1, f1), (v2, f2) = bud_pair(faces)
     s1, s2 = trimesh.Trimesh(v1, f1, process=False), trimesh.Trimesh(v2, f2, process=False)
     start = time.perf_counter()
