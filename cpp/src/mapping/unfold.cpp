@@ -10,6 +10,12 @@
 // it was; then onto S2. Where triangles stay folded the region grows by a ring and the step
 // repeats, a few times at most; a round is kept only when it leaves fewer folds, and what is left
 // stays folded and is counted by quality().
+//
+// Where an image fan straddles a crease of a voxel-made S2 no single tangent plane may hold a
+// kernel (fuzz seed 827098517: a triangle's image lay across a right-angled edge of S2, nearly
+// perpendicular to the face under it). Before the kernel rounds and within each, the corners of
+// the folded triangles therefore also try the umbrella step, towards the mean of their
+// neighbours' ends, judged by the fold test itself (descend below).
 #include "quality/folds.hpp"
 
 #include "surfaces/surface_util.hpp"
@@ -26,6 +32,7 @@ namespace {
 
 using V2 = Eigen::Vector2d;
 constexpr int kRounds = 6;
+constexpr int kSweeps = 3;
 constexpr double kInward = 0.2;
 
 double cross2(const V2& a, const V2& b) { return a.x() * b.y() - a.y() * b.x(); }
@@ -99,11 +106,73 @@ V3 into_kernel(Index v, const std::vector<Index>& around, const FacesRef& faces,
   return origin + chosen.x() * t1 + chosen.y() * t2;
 }
 
+// Greedy moves judged by the fold test itself: each corner of a folded triangle tries the point
+// of S2 closest to the mean of its neighbours' ends, and the point of S2 closest to halfway there;
+// a move is kept only when its fan then has fewer folded triangles, or as many and a better worst
+// one. A move changes only its own fan, so the folds never grow.
+void descend(const FoldTest& test, Points3& ends, const FacesRef& faces, const std::vector<std::vector<Index>>& around,
+             const SurfaceIndex& index2) {
+  struct Score {
+    Index folds = 0;
+    double worst = 1.0;
+    bool better_than(const Score& other) const {
+      return folds < other.folds || (folds == other.folds && worst > other.worst);
+    }
+  };
+  auto score = [&](Index v) {
+    Score s;
+    for (const double a : test.agreement(ends, around[v])) {
+      if (std::isnan(a)) continue;
+      s.folds += a < 0;
+      s.worst = std::min(s.worst, a);
+    }
+    return s;
+  };
+  for (int sweep = 0; sweep < kSweeps; ++sweep) {
+    const std::vector<char> folded = test.folded(ends);
+    std::vector<char> corner(static_cast<std::size_t>(ends.rows()), 0);
+    for (Index j = 0; j < faces.rows(); ++j) {
+      if (!folded[j]) continue;
+      for (int k = 0; k < 3; ++k) corner[faces(j, k)] = 1;
+    }
+    bool moved = false;
+    for (Index v = 0; v < ends.rows(); ++v) {
+      if (!corner[v] || !ends.row(v).allFinite()) continue;
+      V3 mean = V3::Zero();
+      int count = 0;
+      for (const Index j : around[v]) {
+        for (int k = 0; k < 3; ++k) {
+          const Index w = faces(j, k);
+          if (w != v && ends.row(w).allFinite()) mean += ends.row(w).transpose(), ++count;
+        }
+      }
+      if (count == 0) continue;
+      mean /= count;  // a neighbour shared by two triangles counts twice: closer to the fan's middle
+      const V3 old_end = ends.row(v).transpose();
+      Points3 targets(2, 3);
+      targets.row(0) = mean.transpose();
+      targets.row(1) = (0.5 * (old_end + mean)).transpose();
+      const Points3 candidates = index2.closest_points(targets).points;
+      Score best = score(v);
+      V3 chosen = old_end;
+      for (Index c = 0; c < candidates.rows(); ++c) {
+        ends.row(v) = candidates.row(c);
+        const Score s = score(v);
+        if (s.better_than(best)) best = s, chosen = candidates.row(c).transpose();
+      }
+      ends.row(v) = chosen.transpose();
+      moved = moved || chosen != old_end;
+    }
+    if (!moved) return;
+  }
+}
+
 }  // namespace
 
 Index unfold(const Points3Ref& starts, Points3& ends, const FacesRef& faces, const Points3Ref& v1, const FacesRef& f1,
              const SurfaceIndex& index1, const Points3Ref& v2, const FacesRef& f2, const SurfaceIndex& index2) {
-  std::vector<char> folded = folded_faces(starts, ends, faces, v1, f1, index1, v2, f2, index2);
+  const FoldTest test(starts, faces, v1, f1, index1, v2, f2, index2);
+  std::vector<char> folded = test.folded(ends);
   Index left = static_cast<Index>(std::count(folded.begin(), folded.end(), 1));
   if (left == 0) return 0;
   const Index n = starts.rows();
@@ -111,6 +180,9 @@ Index unfold(const Points3Ref& starts, Points3& ends, const FacesRef& faces, con
   for (Index j = 0; j < faces.rows(); ++j) {
     for (int k = 0; k < 3; ++k) around[faces(j, k)].push_back(j);
   }
+  descend(test, ends, faces, around, index2);
+  folded = test.folded(ends);
+  left = static_cast<Index>(std::count(folded.begin(), folded.end(), 1));
   std::vector<char> region(n, 0);
   for (int round = 0; round < kRounds && left > 0; ++round) {
     // The corners of the folded triangles and, after a round that did not help, a ring more.
@@ -134,7 +206,7 @@ Index unfold(const Points3Ref& starts, Points3& ends, const FacesRef& faces, con
     // surface under its fan (the normals the fold test uses: S2's under the fan's corners and
     // centroids; at a crease of S2 one face's normal would disagree with it).
     Points3 trial = ends;
-    for (int sweep = 0; sweep < 3; ++sweep) {
+    for (int sweep = 0; sweep < kSweeps; ++sweep) {
       for (const Index v : rows) {
         std::vector<Index> fan;  // the triangles around v with every corner found
         for (const Index j : around[v]) {
@@ -166,7 +238,8 @@ Index unfold(const Points3Ref& starts, Points3& ends, const FacesRef& faces, con
         trial.row(v) = index2.closest_points(one).points.row(0);
       }
     }
-    std::vector<char> trial_folded = folded_faces(starts, trial, faces, v1, f1, index1, v2, f2, index2);
+    descend(test, trial, faces, around, index2);
+    std::vector<char> trial_folded = test.folded(trial);
     const Index trial_left = static_cast<Index>(std::count(trial_folded.begin(), trial_folded.end(), 1));
     if (trial_left < left) {
       ends.swap(trial);

@@ -82,73 +82,109 @@ V3 unit_face_normal(const Points3Ref& v, const FacesRef& f, Index face, const ch
   return length > 0 ? V3(n / length) : V3::Zero();
 }
 
-// For each triangle of `faces` over the rows of `points` (only where `use`), the sum nu of the unit
-// normals of the surface's faces closest to its three corners and to its centroid. The corners lie
-// on the surface, so their faces give the normal right there, even when the triangle is large
-// against the surface's curvature (across a thin tube its centroid sinks towards the axis); but a
-// corner on a vertex or edge of the surface gets any of the faces meeting there, while the
-// centroid of a small triangle lies over the face it covers. Together they outvote either failure.
-Points3 normals_under(const Points3Ref& points, const FacesRef& faces, const std::vector<char>& use,
+// For each of `triangles` (rows of `faces` over `points`, every corner finite), the sum nu of the
+// unit normals of the surface's faces closest to its three corners and to its centroid. The
+// corners lie on the surface, so their faces give the normal right there, even when the triangle
+// is large against the surface's curvature (across a thin tube its centroid sinks towards the
+// axis); but a corner on a vertex or edge of the surface gets any of the faces meeting there, while
+// the centroid of a small triangle lies over the face it covers. Together they outvote either
+// failure.
+Points3 normals_under(const Points3Ref& points, const FacesRef& faces, const std::vector<Index>& triangles,
                       const Points3Ref& v, const FacesRef& f, const SurfaceIndex& index, const char* name) {
-  const std::vector<Index> rows = detail::finite_rows(points);
-  Points3 at_rows = Points3::Zero(points.rows(), 3);
-  Points3 nu = Points3::Zero(faces.rows(), 3);
-  if (rows.empty()) return nu;
-  {
-    const Points3 queries = points(rows, Eigen::all);
-    const IndexVector hit = index.closest_points(queries).faces;
-    for (std::size_t k = 0; k < rows.size(); ++k)
-      at_rows.row(rows[k]) = unit_face_normal(v, f, hit[k], name).transpose();
+  const Index count = static_cast<Index>(triangles.size());
+  Points3 nu = Points3::Zero(count, 3);
+  if (count == 0) return nu;
+  std::vector<Index> corners;  // the distinct corners, each queried once
+  corners.reserve(3 * triangles.size());
+  for (const Index j : triangles) {
+    for (int k = 0; k < 3; ++k) corners.push_back(faces(j, k));
   }
-  std::vector<Index> triangles;
-  for (Index j = 0; j < faces.rows(); ++j) {
-    if (use[j]) triangles.push_back(j);
-  }
-  if (triangles.empty()) return nu;
-  Points3 centroids(triangles.size(), 3);
-  for (std::size_t k = 0; k < triangles.size(); ++k) {
-    const Index j = triangles[k];
+  std::sort(corners.begin(), corners.end());
+  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+  const IndexVector corner_hit = index.closest_points(points(corners, Eigen::all)).faces;
+  auto at_corner = [&](Index row) {
+    const auto k = std::lower_bound(corners.begin(), corners.end(), row) - corners.begin();
+    return unit_face_normal(v, f, corner_hit[k], name);
+  };
+  Points3 centroids(count, 3);
+  for (Index k = 0; k < count; ++k) {
+    const Index j = triangles[static_cast<std::size_t>(k)];
     centroids.row(k) = (points.row(faces(j, 0)) + points.row(faces(j, 1)) + points.row(faces(j, 2))) / 3.0;
   }
   const IndexVector hit = index.closest_points(centroids).faces;
-  for (std::size_t k = 0; k < triangles.size(); ++k) {
-    const Index j = triangles[k];
-    nu.row(j) = unit_face_normal(v, f, hit[k], name).transpose() + at_rows.row(faces(j, 0)) + at_rows.row(faces(j, 1)) +
-                at_rows.row(faces(j, 2));
+  for (Index k = 0; k < count; ++k) {
+    const Index j = triangles[static_cast<std::size_t>(k)];
+    nu.row(k) = (unit_face_normal(v, f, hit[k], name) + at_corner(faces(j, 0)) + at_corner(faces(j, 1)) +
+                 at_corner(faces(j, 2)))
+                    .transpose();
   }
   return nu;
 }
 
+V3 triangle_normal(const Points3Ref& points, const FacesRef& faces, Index j) {
+  const V3 a = detail::corner(points, faces, j, 0);
+  return (detail::corner(points, faces, j, 1) - a).cross(detail::corner(points, faces, j, 2) - a);
+}
+
+std::vector<Index> all_rows(Index count) {
+  std::vector<Index> rows(static_cast<std::size_t>(count));
+  for (Index j = 0; j < count; ++j) rows[static_cast<std::size_t>(j)] = j;
+  return rows;
+}
+
 }  // namespace
 
-std::vector<char> detail::folded_faces(const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces,
-                                       const Points3Ref& v1, const FacesRef& f1, const SurfaceIndex& index1,
-                                       const Points3Ref& v2, const FacesRef& f2, const SurfaceIndex& index2) {
-  if (ends.rows() != starts.rows()) detail::invalid("ends", "must have as many rows as starts");
+detail::FoldTest::FoldTest(const Points3Ref& starts, const FacesRef& faces, const Points3Ref& v1, const FacesRef& f1,
+                           const SurfaceIndex& index1, const Points3Ref& v2, const FacesRef& f2,
+                           const SurfaceIndex& index2)
+    : starts_(starts), faces_(faces), v2_(v2), f2_(f2), index2_(index2), start_sign_(faces.rows(), 0) {
   require_field_faces(faces, starts.rows(), "faces");
-  std::vector<char> use(faces.rows());
-  for (Index j = 0; j < faces.rows(); ++j) use[j] = usable(starts, ends, faces, j);
-  const Points3 nu1 = normals_under(starts, faces, use, v1, f1, index1, "s1");
-  const Points3 nu2 = normals_under(ends, faces, use, v2, f2, index2, "s2");
-  std::vector<char> folded(faces.rows(), 0);
-  tbb::parallel_for(tbb::blocked_range<Index>(0, faces.rows(), 1024), [&](const tbb::blocked_range<Index>& range) {
-    for (Index j = range.begin(); j < range.end(); ++j) {
-      if (!use[j]) continue;
-      const V3 p0 = detail::corner(starts, faces, j, 0), q0 = detail::corner(ends, faces, j, 0);
-      const V3 n = (detail::corner(starts, faces, j, 1) - p0).cross(detail::corner(starts, faces, j, 2) - p0);
-      const V3 m = (detail::corner(ends, faces, j, 1) - q0).cross(detail::corner(ends, faces, j, 2) - q0);
-      // Signs only: the product of two dot products of unscaled vectors could underflow.
-      const double on1 = n.dot(nu1.row(j).transpose()), on2 = m.dot(nu2.row(j).transpose());
-      folded[j] = (on1 < 0 && on2 > 0) || (on1 > 0 && on2 < 0);
-    }
-  });
-  return folded;
+  std::vector<Index> placed;  // the triangles with every start
+  for (Index j = 0; j < faces.rows(); ++j) {
+    if (usable(starts, starts, faces, j)) placed.push_back(j);
+  }
+  const Points3 nu1 = normals_under(starts, faces, placed, v1, f1, index1, "s1");
+  for (std::size_t k = 0; k < placed.size(); ++k) {
+    const double on1 = triangle_normal(starts, faces, placed[k]).dot(nu1.row(static_cast<Index>(k)).transpose());
+    start_sign_[static_cast<std::size_t>(placed[k])] = static_cast<signed char>((on1 > 0) - (on1 < 0));
+  }
+}
+
+std::vector<double> detail::FoldTest::agreement(const Points3Ref& ends, const std::vector<Index>& triangles) const {
+  if (ends.rows() != starts_.rows()) detail::invalid("ends", "must have as many rows as starts");
+  std::vector<double> out(triangles.size(), kNaN);
+  std::vector<Index> placed;  // positions in `triangles` with every start and end
+  for (std::size_t k = 0; k < triangles.size(); ++k) {
+    if (usable(starts_, ends, faces_, triangles[k])) placed.push_back(static_cast<Index>(k));
+  }
+  std::vector<Index> rows(placed.size());
+  for (std::size_t k = 0; k < placed.size(); ++k) rows[k] = triangles[static_cast<std::size_t>(placed[k])];
+  const Points3 nu2 = normals_under(ends, faces_, rows, v2_, f2_, index2_, "s2");
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows.size(), 1024),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t k = range.begin(); k < range.end(); ++k) {
+                        const V3 m = triangle_normal(ends, faces_, rows[k]);
+                        const V3 n = nu2.row(static_cast<Index>(k)).transpose();
+                        const double scale = m.norm() * n.norm();
+                        const double sign = start_sign_[static_cast<std::size_t>(rows[k])];
+                        // 0 rather than 0/0 where the image or the normal under it is flat.
+                        out[static_cast<std::size_t>(placed[k])] = scale > 0 ? sign * m.dot(n) / scale : 0.0;
+                      }
+                    });
+  return out;
+}
+
+std::vector<char> detail::FoldTest::folded(const Points3Ref& ends) const {
+  const std::vector<double> a = agreement(ends, all_rows(faces_.rows()));
+  std::vector<char> out(a.size());
+  for (std::size_t j = 0; j < a.size(); ++j) out[j] = a[j] < 0;
+  return out;
 }
 
 Index count_folds(const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, const Points3Ref& v1,
                   const FacesRef& f1, const SurfaceIndex& index1, const Points3Ref& v2, const FacesRef& f2,
                   const SurfaceIndex& index2) {
-  const std::vector<char> folded = detail::folded_faces(starts, ends, faces, v1, f1, index1, v2, f2, index2);
+  const std::vector<char> folded = detail::FoldTest(starts, faces, v1, f1, index1, v2, f2, index2).folded(ends);
   return static_cast<Index>(std::count(folded.begin(), folded.end(), 1));
 }
 
