@@ -109,7 +109,8 @@ V3 into_kernel(Index v, const std::vector<Index>& around, const FacesRef& faces,
 // Greedy moves judged by the fold test itself: each corner of a folded triangle tries the point
 // of S2 closest to the mean of its neighbours' ends, and the point of S2 closest to halfway there;
 // a move is kept only when its fan then has fewer folded triangles, or as many and a better worst
-// one. A move changes only its own fan, so the folds never grow.
+// one. A move changes only its own fan, so the folds never grow; the next sweep tries the corners
+// of the triangles still folded in the fans that moved (their neighbours' means changed).
 void descend(const FoldTest& test, Points3& ends, const FacesRef& faces, const std::vector<std::vector<Index>>& around,
              const SurfaceIndex& index2) {
   struct Score {
@@ -128,13 +129,14 @@ void descend(const FoldTest& test, Points3& ends, const FacesRef& faces, const s
     }
     return s;
   };
+  std::vector<char> corner(static_cast<std::size_t>(ends.rows()), 0);
+  const std::vector<char> folded = test.folded(ends);
+  for (Index j = 0; j < faces.rows(); ++j) {
+    if (!folded[j]) continue;
+    for (int k = 0; k < 3; ++k) corner[faces(j, k)] = 1;
+  }
   for (int sweep = 0; sweep < kSweeps; ++sweep) {
-    const std::vector<char> folded = test.folded(ends);
-    std::vector<char> corner(static_cast<std::size_t>(ends.rows()), 0);
-    for (Index j = 0; j < faces.rows(); ++j) {
-      if (!folded[j]) continue;
-      for (int k = 0; k < 3; ++k) corner[faces(j, k)] = 1;
-    }
+    std::vector<char> next(corner.size(), 0);
     bool moved = false;
     for (Index v = 0; v < ends.rows(); ++v) {
       if (!corner[v] || !ends.row(v).allFinite()) continue;
@@ -161,9 +163,16 @@ void descend(const FoldTest& test, Points3& ends, const FacesRef& faces, const s
         if (s.better_than(best)) best = s, chosen = candidates.row(c).transpose();
       }
       ends.row(v) = chosen.transpose();
-      moved = moved || chosen != old_end;
+      if (chosen == old_end) continue;
+      moved = true;
+      const std::vector<double> after = test.agreement(ends, around[v]);
+      for (std::size_t i = 0; i < after.size(); ++i) {
+        if (!(after[i] < 0)) continue;
+        for (int k = 0; k < 3; ++k) next[faces(around[v][i], k)] = 1;
+      }
     }
     if (!moved) return;
+    corner.swap(next);
   }
 }
 
