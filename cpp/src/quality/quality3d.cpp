@@ -160,17 +160,18 @@ std::vector<double> detail::FoldTest::agreement(const Points3Ref& ends, const st
   std::vector<Index> rows(placed.size());
   for (std::size_t k = 0; k < placed.size(); ++k) rows[k] = triangles[static_cast<std::size_t>(placed[k])];
   const Points3 nu2 = normals_under(ends, faces_, rows, v2_, f2_, index2_, "s2");
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows.size(), 1024),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t k = range.begin(); k < range.end(); ++k) {
-                        const V3 m = triangle_normal(ends, faces_, rows[k]);
-                        const V3 n = nu2.row(static_cast<Index>(k)).transpose();
-                        const double scale = m.norm() * n.norm();
-                        const double sign = start_sign_[static_cast<std::size_t>(rows[k])];
-                        // 0 rather than 0/0 where the image or the normal under it is flat.
-                        out[static_cast<std::size_t>(placed[k])] = scale > 0 ? sign * m.dot(n) / scale : 0.0;
-                      }
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, rows.size(), 1024), [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t k = range.begin(); k < range.end(); ++k) {
+          const V3 m = triangle_normal(ends, faces_, rows[k]);
+          const V3 n = nu2.row(static_cast<Index>(k)).transpose();
+          const double on2 = m.dot(n), scale = m.norm() * n.norm();
+          // The sign decides (0 where the image or the normal under it is flat);
+          // the cosine only ranks, and a tiny image whose norm underflows keeps its sign.
+          const double cosine = scale > 0 ? on2 / scale : double((on2 > 0) - (on2 < 0));
+          out[static_cast<std::size_t>(placed[k])] = start_sign_[static_cast<std::size_t>(rows[k])] * cosine;
+        }
+      });
   return out;
 }
 
