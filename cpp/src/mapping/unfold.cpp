@@ -111,8 +111,9 @@ V3 into_kernel(Index v, const std::vector<Index>& around, const FacesRef& faces,
 // a move is kept only when its fan then has fewer folded triangles, or as many and a better worst
 // one. A move changes only its own fan, so the folds never grow; the next sweep tries the corners
 // of the triangles still folded in the fans that moved (their neighbours' means changed).
-void descend(const FoldTest& test, Points3& ends, const FacesRef& faces, const std::vector<std::vector<Index>>& around,
-             const SurfaceIndex& index2) {
+// `folded` (test.folded(ends) on entry) is kept so: each move retests the fan it changed.
+void descend(const FoldTest& test, Points3& ends, std::vector<char>& folded, const FacesRef& faces,
+             const std::vector<std::vector<Index>>& around, const SurfaceIndex& index2) {
   struct Score {
     Index folds = 0;
     double worst = 1.0;
@@ -130,7 +131,6 @@ void descend(const FoldTest& test, Points3& ends, const FacesRef& faces, const s
     return s;
   };
   std::vector<char> corner(static_cast<std::size_t>(ends.rows()), 0);
-  const std::vector<char> folded = test.folded(ends);
   for (Index j = 0; j < faces.rows(); ++j) {
     if (!folded[j]) continue;
     for (int k = 0; k < 3; ++k) corner[faces(j, k)] = 1;
@@ -167,8 +167,10 @@ void descend(const FoldTest& test, Points3& ends, const FacesRef& faces, const s
       moved = true;
       const std::vector<double> after = test.agreement(ends, around[v]);
       for (std::size_t i = 0; i < after.size(); ++i) {
-        if (!(after[i] < 0)) continue;
-        for (int k = 0; k < 3; ++k) next[faces(around[v][i], k)] = 1;
+        const Index j = around[v][i];
+        folded[j] = after[i] < 0;
+        if (!folded[j]) continue;
+        for (int k = 0; k < 3; ++k) next[faces(j, k)] = 1;
       }
     }
     if (!moved) return;
@@ -189,8 +191,7 @@ Index unfold(const Points3Ref& starts, Points3& ends, const FacesRef& faces, con
   for (Index j = 0; j < faces.rows(); ++j) {
     for (int k = 0; k < 3; ++k) around[faces(j, k)].push_back(j);
   }
-  descend(test, ends, faces, around, index2);
-  folded = test.folded(ends);
+  descend(test, ends, folded, faces, around, index2);
   left = static_cast<Index>(std::count(folded.begin(), folded.end(), 1));
   std::vector<char> region(n, 0);
   for (int round = 0; round < kRounds && left > 0; ++round) {
@@ -247,8 +248,8 @@ Index unfold(const Points3Ref& starts, Points3& ends, const FacesRef& faces, con
         trial.row(v) = index2.closest_points(one).points.row(0);
       }
     }
-    descend(test, trial, faces, around, index2);
     std::vector<char> trial_folded = test.folded(trial);
+    descend(test, trial, trial_folded, faces, around, index2);
     const Index trial_left = static_cast<Index>(std::count(trial_folded.begin(), trial_folded.end(), 1));
     if (trial_left < left) {
       ends.swap(trial);

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <string>
 #include <vector>
 
@@ -126,12 +127,6 @@ V3 triangle_normal(const Points3Ref& points, const FacesRef& faces, Index j) {
   return (detail::corner(points, faces, j, 1) - a).cross(detail::corner(points, faces, j, 2) - a);
 }
 
-std::vector<Index> all_rows(Index count) {
-  std::vector<Index> rows(static_cast<std::size_t>(count));
-  for (Index j = 0; j < count; ++j) rows[static_cast<std::size_t>(j)] = j;
-  return rows;
-}
-
 }  // namespace
 
 detail::FoldTest::FoldTest(const Points3Ref& starts, const FacesRef& faces, const Points3Ref& v1, const FacesRef& f1,
@@ -176,7 +171,9 @@ std::vector<double> detail::FoldTest::agreement(const Points3Ref& ends, const st
 }
 
 std::vector<char> detail::FoldTest::folded(const Points3Ref& ends) const {
-  const std::vector<double> a = agreement(ends, all_rows(faces_.rows()));
+  std::vector<Index> every(static_cast<std::size_t>(faces_.rows()));
+  std::iota(every.begin(), every.end(), Index{0});
+  const std::vector<double> a = agreement(ends, every);
   std::vector<char> out(a.size());
   for (std::size_t j = 0; j < a.size(); ++j) out[j] = a[j] < 0;
   return out;
