@@ -238,6 +238,19 @@ def test_a_coarse_inner_sphere_is_as_accurate_by_default():
     assert angular_rms(inner[0], solution.ends, 4.0) < 0.01
 
 
+def test_a_thin_shell_meshes_to_its_surfaces_spacing_not_to_a_quarter_of_its_gap():
+    # Spheres of radii 1 and 1.1 with 642 vertices (mean edge 0.15-0.17, mean gap 0.1): a quarter
+    # of the gap is six times finer than the triangles and gave ~380k tetrahedra; the default is
+    # now half the gap (two elements across), and the streamlines stay radial to 1% of the gap.
+    inner, outer = sphere(1.0, 3), sphere(1.1, 3)
+    solution = mm.solve_diffusion_3d(inner, outer)
+    assert len(solution.tetrahedra) < 100_000, len(solution.tetrahedra)
+    assert np.isfinite(solution.ends).all()
+    assert angular_rms(inner[0], solution.ends, 1.1) < 1e-3
+    field = mm.DisplacementField(inner[0], solution.ends, np.full(len(inner[0]), "diffusion"), faces=inner[1])
+    assert mm.quality(field, inner, outer).folds == 0
+
+
 _REPEAT_SCRIPT = """
 import hashlib, os, sys
 import numpy as np, trimesh

@@ -370,6 +370,15 @@ Cleared clear_and_classify(const Points3Ref& source_vertices, const FacesRef& so
   }
 }
 
+// The largest element size when the caller gives none: a quarter of the mean gap, four elements
+// across the shell. In a thin shell (frames a voxel apart) that is finer than the surfaces'
+// own spacing, and the tetrahedra grow as the area over the gap squared (a 2.5k-vertex swell pair
+// 0.76 voxel apart: 970k tetrahedra, over a minute); there half the spacing is fine enough, but
+// never more than half the gap, two elements across. Measured in bench/README.md ("Thin shells").
+double default_cell_size(double gap, double spacing) {
+  return std::max(0.25 * gap, std::min(0.5 * gap, 0.5 * spacing));
+}
+
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -449,20 +458,23 @@ ShellDiffusionSolution detail::solve_diffusion_3d(const ShellPair& pair, const S
   const double volume = crossing ? crossing->volume() : std::abs(target.volume - source.volume);
   // Where the surfaces touch, they bound no region: leave that part out of the mean.
   const double gap = volume / std::max(0.5 * (source.area + target.area) - cleared.near_area, 0.05 * source.area);
-  detail::ShellMeshCriteria criteria;
-  criteria.cell_size = options.mesh_size > 0.0 ? options.mesh_size : 0.25 * gap;
-  // Near the source, where the streamlines start, the elements stay within a fraction of the
-  // source's size however coarse its triangles are (the end error follows the element size
-  // there: concentric spheres r = 1 -> 4 with 642 vertices gave RMS 0.018 at the triangles' size).
-  // Nor does it follow triangles finer than 1% of a surface's diagonal: a finer spacing describes
-  // the surface, not a shape the field must resolve (where the surface curves, facet_distance
-  // refines), and following it made the mesh grow with the surfaces' resolution (five times the
-  // tetrahedra, eight times the time, for a lumpy pair of 100k faces; bench/README.md).
+  // The input spacing: the mean edge, but not finer than 1% of a surface's diagonal: a finer
+  // spacing describes the surface, not a shape the field must resolve (where the surface curves,
+  // facet_distance refines), and following it made the mesh grow with the surfaces' resolution
+  // (five times the tetrahedra, eight times the time, for a lumpy pair of 100k faces;
+  // bench/README.md). Near the source, where the streamlines start, the elements stay within a
+  // fraction of the source's size however coarse its triangles are (the end error follows the
+  // element size there: concentric spheres r = 1 -> 4 with 642 vertices gave RMS 0.018 at the
+  // triangles' size).
   const double source_diagonal = (source_vertices.colwise().maxCoeff() - source_vertices.colwise().minCoeff()).norm();
   const double target_diagonal = (target_vertices.colwise().maxCoeff() - target_vertices.colwise().minCoeff()).norm();
-  criteria.source_size = std::min({std::max(source.mean_edge, kFinestFraction * source_diagonal), criteria.cell_size,
-                                   kSourceFraction * source_diagonal});
-  criteria.target_size = std::min(std::max(target.mean_edge, kFinestFraction * target_diagonal), criteria.cell_size);
+  const double source_spacing = std::max(source.mean_edge, kFinestFraction * source_diagonal);
+  const double target_spacing = std::max(target.mean_edge, kFinestFraction * target_diagonal);
+  detail::ShellMeshCriteria criteria;
+  criteria.cell_size =
+      options.mesh_size > 0.0 ? options.mesh_size : default_cell_size(gap, std::min(source_spacing, target_spacing));
+  criteria.source_size = std::min({source_spacing, criteria.cell_size, kSourceFraction * source_diagonal});
+  criteria.target_size = std::min(target_spacing, criteria.cell_size);
   criteria.grading = 0.1;
   criteria.exude = true;
   criteria.parallel = !options.repeatable && !crossing;
