@@ -17,9 +17,11 @@
    only, never a dependency) meshing the shell with quality switches, then scikit-fem's P1
    assembly. Each case runs in its own process; peak memory is the process's plus its children's
    (the mesher's) largest resident sets, an upper bound.
-5. A new bud (--bud): map_surfaces(..., "auto") on a lumpy pair of 100k faces where S2 grows one
-   bud over a narrow pit of S1, so that normal mapping folds around the pit only: the share of the
-   surface that folds, the time of normal mapping and of auto end to end.
+5. A new bud (--bud): map_surfaces(..., "auto") on lumpy pairs of 20k and 100k faces where S2 grows
+   one bud over a narrow pit of S1, so that normal mapping folds around the pit only: the share of
+   the surface that folds and that auto redoes with diffusion, the time of normal mapping and of
+   auto end to end, beside reverse and forward diffusion over the whole surface, and how far the
+   redone ends lie from forward diffusion's.
 
 --all-cores runs every table with repeatable=False (Mesh_3's parallel mode on all cores).
 """
@@ -35,6 +37,7 @@ import time
 
 import numpy as np
 import pytest
+from scipy.spatial import cKDTree
 
 import morphomap as mm
 
@@ -175,23 +178,43 @@ def bud_pair(faces):
     return (u * (lumpy - pit)[:, None], triangles), (u * (1.15 * lumpy + bud)[:, None], triangles)
 
 
-def bud_table(faces):
-    """Normal mapping on the bud pair (its folds), then auto, which starts with it and falls back where it folds."""
-    (v1, f1), (v2, f2) = bud_pair(faces)
-    s1, s2 = trimesh.Trimesh(v1, f1, process=False), trimesh.Trimesh(v2, f2, process=False)
-    start = time.perf_counter()
-    normal = mm.map_surfaces(s1, s2, "normal")
-    normal_seconds = time.perf_counter() - start
-    folded = mm.quality(normal, s1, s2).folds
-    start = time.perf_counter()
-    auto = mm.map_surfaces(s1, s2, "auto", repeatable=REPEATABLE)
-    auto_seconds = time.perf_counter() - start
-    q = mm.quality(auto, s1, s2)
-    methods = ", ".join(sorted(map(str, set(auto.method))))
-    print(f"\n5. A new bud ({len(f1):,} faces per surface): normal mapping {normal_seconds:.1f} s, {folded:,} folded "
-          f"faces ({folded / len(f1):.1%} of the surface)")
-    print(f"   auto: {auto_seconds:.1f} s end to end, methods {methods}, {len(auto):,} vectors, {q.folds} folds, "
-          f"{int((~auto.valid).sum())} lost")
+def bud_table(sizes):
+    """Normal mapping on the bud pair (its folds); auto, which keeps it and diffuses near the folds
+    only; and the whole-surface diffusions auto used before (reverse) and that the local part is
+    measured against (forward): time, and the distance of the inner redone ends (a gap or more from
+    the normal part, not blended) from the forward ones."""
+    print("\n5. A new bud: auto (normal, diffusion near its folds) beside diffusion over the whole surface")
+    print("   faces  folded  normal s  auto s  redone  | reverse s  forward s  forward tets  "
+          "| inner local - forward RMS  max  (mean gap)  | auto folds lost")
+    for faces in sizes:
+        (v1, f1), (v2, f2) = bud_pair(faces)
+        s1, s2 = trimesh.Trimesh(v1, f1, process=False), trimesh.Trimesh(v2, f2, process=False)
+        gap = (s2.volume - s1.volume) / (0.5 * (s1.area + s2.area))
+        start = time.perf_counter()
+        normal = mm.map_surfaces(s1, s2, "normal")
+        normal_seconds = time.perf_counter() - start
+        folded = mm.quality(normal, s1, s2).folds
+        start = time.perf_counter()
+        auto = mm.map_surfaces(s1, s2, "auto", repeatable=REPEATABLE)
+        auto_seconds = time.perf_counter() - start
+        q = mm.quality(auto, s1, s2)
+        redone = np.asarray(auto.method) != "normal"
+        start = time.perf_counter()
+        mm.map_surfaces(s1, s2, "diffusion", reverse=True, repeatable=REPEATABLE)
+        reverse_seconds = time.perf_counter() - start
+        start = time.perf_counter()
+        forward = mm.solve_diffusion_3d(s1, s2, repeatable=REPEATABLE)
+        forward_seconds = time.perf_counter() - start
+        # The vertices a gap or more inside the redone part have diffusion's ends, not a blend.
+        inner = redone.copy()
+        if (~redone).any():
+            inner[redone] = cKDTree(v1[~redone]).query(v1[redone])[0] >= gap
+        gone = np.linalg.norm(np.asarray(auto.ends)[inner] - forward.ends[inner], axis=1)
+        print(f"  {len(f1):>6,}  {folded:>6,}  {normal_seconds:>8.1f}  {auto_seconds:>6.1f}  {redone.mean():>6.1%}  "
+              f"| {reverse_seconds:>9.1f}  {forward_seconds:>9.1f}  {len(forward.tetrahedra):>12,}  "
+              f"| {inner.sum():>5} {np.sqrt(np.mean(gone ** 2)) if len(gone) else 0:>19.2e}  "
+              f"{gone.max(initial=0):.2e}  ({gap:.3f})  "
+              f"| {q.folds} {int((~auto.valid).sum())}  methods {', '.join(sorted(map(str, set(auto.method))))}")
 
 
 def peak_memory_gb():
@@ -291,7 +314,8 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quick", action="store_true", help="default mesh sizes only")
     parser.add_argument("--organ", action="store_true", help="only the organ-scale table (4), ~10 min")
-    parser.add_argument("--bud", action="store_true", help="only the new-bud table (5)")
+    parser.add_argument("--bud", nargs="*", type=int, metavar="FACES",
+                        help="only the new-bud table (5); faces per surface (default 20000 100000)")
     parser.add_argument("--all-cores", action="store_true", help="repeatable=False: Mesh_3 on all cores")
     parser.add_argument("--case", nargs=2, metavar=("KIND", "FACES"), help=argparse.SUPPRESS)
     args = parser.parse_args()
@@ -301,8 +325,8 @@ def main():
         kind, faces = args.case[0], int(args.case[1])
         print(json.dumps(organ_morphomap(faces) if kind == "morphomap" else organ_peer(faces)))
         return
-    if args.bud:
-        bud_table(100_000)
+    if args.bud is not None:
+        bud_table(args.bud or [20_000, 100_000])
         return
     if args.organ:
         organ_table([10_000, 20_000, 100_000, 200_000], {20_000, 100_000, 200_000})

@@ -98,14 +98,30 @@ def test_auto_gives_no_folds(pair, auto):
     print(f"auto: methods {methods}, folds {q.folds}, QM1 {q.qm1:.4g}, QM2 {q.qm2:.4g}, QM {q.qm:.4g}")
     assert q.folds == 0
     assert auto.valid.all()
-    # Normal mapping folds here, so "auto" takes reverse diffusion for the whole surface: the
-    # vectors run from S1 to the vertices of S2, in S2's order and with S2's faces.
-    assert methods == ["reverse_diffusion"]
-    assert len(auto) == len(s2.vertices)
-    np.testing.assert_array_equal(auto.faces, s2.faces)
-    assert distances_to(auto.starts, s1).max() < 1e-6 * diagonal(s1)
+    # Normal mapping folds at the branch points only, so "auto" keeps it elsewhere and takes
+    # diffusion near them: the vectors run from the vertices of S1, in S1's order, with S1's faces.
+    assert methods == ["diffusion", "normal"]
+    np.testing.assert_array_equal(auto.starts, s1.vertices)
+    np.testing.assert_array_equal(auto.faces, s1.faces)
+    kept = auto.method == "normal"
+    np.testing.assert_array_equal(auto.ends[kept], mm.map_surfaces(s1, s2, "normal").ends[kept])
+    assert kept.mean() > 0.5
     assert distances_to(auto.ends, s2).max() < 1e-6 * diagonal(s2)
     assert turned_over(auto, s1, s2) == 0
+
+
+def test_reverse_diffusion_gives_no_folds(pair):
+    # What "auto" took for the whole surface before it diffused near the folds only: the vectors
+    # run from S1 to the vertices of S2, in S2's order and with S2's faces.
+    s1, s2 = pair
+    field = mm.map_surfaces(s1, s2, "diffusion", reverse=True)
+    assert field.valid.all() and set(field.method) == {"reverse_diffusion"}
+    assert len(field) == len(s2.vertices)
+    np.testing.assert_array_equal(field.faces, s2.faces)
+    assert distances_to(field.starts, s1).max() < 1e-6 * diagonal(s1)
+    assert distances_to(field.ends, s2).max() < 1e-6 * diagonal(s2)
+    assert mm.quality(field, s1, s2).folds == 0
+    assert turned_over(field, s1, s2) == 0
 
 
 def test_quality_table(pair, auto):
@@ -128,20 +144,23 @@ def test_quality_table(pair, auto):
 
 
 def test_long_buds_auto_turns_no_triangle_over(long_buds):
-    # With longer buds the reverse-diffusion field is still orientation-preserving on the
-    # surfaces: no image triangle is turned over relative to S1 or S2.
+    # With longer buds the field of "auto" (normal, diffusion near the branch points) is still
+    # orientation-preserving on the surfaces: no image triangle is turned over relative to S1 or S2.
     s1, s2, field = long_buds
-    assert field.valid.all() and set(field.method) == {"reverse_diffusion"}
+    assert field.valid.all() and set(field.method) == {"normal", "diffusion"}
     assert turned_over(field, s1, s2) == 0
+    assert mm.quality(field, s1, s2).folds == 0
 
 
-def test_long_buds_auto_gives_no_folds(long_buds):
-    s1, s2, field = long_buds
+def test_long_buds_reverse_diffusion_tilts_images_but_folds_none(long_buds):
+    s1, s2, _ = long_buds
+    field = mm.map_surfaces(s1, s2, "diffusion", reverse=True)
     q = mm.quality(field, s1, s2)
     f = field.faces
     n = np.cross(field.starts[f[:, 1]] - field.starts[f[:, 0]], field.starts[f[:, 2]] - field.starts[f[:, 0]])
     image = np.cross(field.ends[f[:, 1]] - field.ends[f[:, 0]], field.ends[f[:, 2]] - field.ends[f[:, 0]])
     tilted = int((np.einsum("ij,ij->i", n, image) < 0).sum())
-    print(f"long buds, auto: {q.folds} folds, {tilted} images tilted by more than 90 degrees")
+    print(f"long buds, reverse diffusion: {q.folds} folds, {tilted} images tilted by more than 90 degrees")
     assert tilted > 0  # what folds counted when it compared the two normals in space
     assert q.folds == 0
+    assert turned_over(field, s1, s2) == 0

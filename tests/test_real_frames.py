@@ -342,3 +342,25 @@ def test_surfaces_touching_over_a_patch_map_with_diffusion(seed):
         assert max(on_s2.max(), on_s1.max()) < 1e-9 * np.ptp(v2, axis=0).max()
         assert any("minimal_distance" in name for name in set(np.asarray(field.method).tolist()))
     assert np.all(mm.map_surfaces(made.s1, made.s2, method="auto").valid)
+
+
+def test_auto_on_segmented_lung_stacks_diffuses_near_the_branch_points_only():
+    """The lung-like pair as voxel stacks (2 x 1 x 1 um), contoured and smoothed as a lab would:
+    normal mapping folds about 70 triangles at the branch points, and "auto" redoes only the
+    vertices near them with diffusion (about a quarter of S1), keeping the normal field elsewhere."""
+    from morphomap.synthetic.masks import lung_stacks
+
+    stack1, stack2, spacing = lung_stacks((2.0, 1.0, 1.0))
+    s1 = mm.surface_from_mask(stack1, spacing, smooth=1.0)
+    s2 = mm.surface_from_mask(stack2, spacing, smooth=1.0)
+    normal = mm.map_surfaces(s1, s2, "normal")
+    assert mm.quality(normal, s1, s2).folds > 0
+    field = mm.map_surfaces(s1, s2, "auto")
+    assert set(field.method) == {"normal", "diffusion"}
+    np.testing.assert_array_equal(field.starts, s1.vertices)
+    np.testing.assert_array_equal(field.faces, s1.faces)
+    assert field.valid.all() and mm.quality(field, s1, s2).folds == 0
+    kept = field.method == "normal"
+    assert kept.mean() > 0.5
+    np.testing.assert_array_equal(field.ends[kept], normal.ends[kept])
+    assert mm.SurfaceIndex(s2.vertices, s2.faces).closest_points(field.ends).distances.max() < 1e-9

@@ -372,6 +372,41 @@ def test_auto_falls_back_to_reverse_diffusion_where_normals_miss(sphere):
     np.testing.assert_array_equal(field.ends[valid], v2[valid])
 
 
+def test_auto_diffuses_only_near_a_new_bud_where_normal_mapping_folds():
+    # S1: a sphere with a pit; S2: 1.15 times the sphere with a bud over the pit. The normals of
+    # the pit cross (72 folds), elsewhere they are sound: "auto" keeps the normal field there and
+    # takes forward diffusion near the pit, from S1's vertices, blended into the normal field
+    # across a band a gap wide.
+    from scipy.spatial import cKDTree
+
+    trimesh = pytest.importorskip("trimesh")
+    u, faces = icosphere(4)
+    angle = np.arccos(np.clip(u[:, 2], -1, 1))
+    v1 = u * (1 - 0.25 * np.exp(-0.5 * (angle / 0.15) ** 2))[:, None]
+    v2 = u * (1.15 + 0.6 * np.exp(-0.5 * (angle / 0.35) ** 2))[:, None]
+    s1, s2 = trimesh.Trimesh(v1, faces), trimesh.Trimesh(v2, faces)
+    gap = (s2.volume - s1.volume) / (0.5 * (s1.area + s2.area))
+    normal = mm.map_surfaces(s1, s2, "normal")
+    assert mm.quality(normal, s1, s2).folds > 0
+    field = mm.map_surfaces(s1, s2, "auto")
+    assert set(field.method) == {"normal", "diffusion"}
+    np.testing.assert_array_equal(field.starts, v1)
+    np.testing.assert_array_equal(field.faces, faces)
+    assert field.valid.all() and mm.quality(field, s1, s2).folds == 0
+    assert mm.SurfaceIndex(v2, faces).closest_points(field.ends).distances.max() < 1e-9
+    redone = field.method == "diffusion"
+    np.testing.assert_array_equal(field.ends[~redone], normal.ends[~redone])
+    # Only around the pit (its normals fold within ~20 degrees of the axis), an eighth of S1.
+    assert redone.mean() < 0.125 and np.degrees(angle[redone]).max() < 45
+    # A gap or more inside the redone part the ends are diffusion's (the mesh coarser away from
+    # it): as close to diffusion over the whole region as two meshes of it are to each other.
+    inner = redone.copy()
+    inner[redone] = cKDTree(v1[~redone]).query(v1[redone])[0] >= gap
+    assert inner.sum() > 100
+    apart = np.linalg.norm(field.ends[inner] - mm.map_surfaces(s1, s2, "diffusion").ends[inner], axis=1)
+    assert np.sqrt(np.mean(apart**2)) < 0.05 * gap and apart.max() < 0.25 * gap
+
+
 def test_prepared_surfaces_give_the_same_fields_and_quality(sphere):
     s1, s2 = mm.PreparedSurface(sphere, "frame 1"), mm.PreparedSurface(ellipsoid(3), "frame 2")
     for method, reverse in (("normal", False), ("minimal_distance", False), ("auto", False), ("normal", True)):

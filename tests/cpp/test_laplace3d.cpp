@@ -2,6 +2,8 @@
 // is (1/r - 1/R) / (1/r0 - 1/R) and the streamlines are radial.
 #include <morphomap/errors.hpp>
 #include <morphomap/laplace3d.hpp>
+#include <morphomap/quality.hpp>
+#include <morphomap/surface_mapping.hpp>
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
@@ -166,6 +168,43 @@ void bad_input() {
   CHECK_THROWS(solve_diffusion_3d(a.vertices, a.faces, b.vertices, b.faces, negative), InvalidInput);
 }
 
+// S1 a sphere with a pit, S2 1.15 times the sphere with a bud over it: normal mapping folds at the
+// pit only, so "auto" keeps the normal vectors elsewhere and diffuses near the pit.
+void automatic_diffuses_near_a_bud_only() {
+  using morphomap::MapMethod;
+  using morphomap::Method;
+  const Surface sphere = icosphere(3);
+  Surface s1 = sphere, s2 = sphere;
+  for (Index i = 0; i < sphere.vertices.rows(); ++i) {
+    const double angle = std::acos(std::clamp(sphere.vertices(i, 2), -1.0, 1.0));
+    s1.vertices.row(i) *= 1.0 - 0.25 * std::exp(-0.5 * std::pow(angle / 0.2, 2));
+    s2.vertices.row(i) *= 1.15 + 0.6 * std::exp(-0.5 * std::pow(angle / 0.4, 2));
+  }
+  morphomap::SurfaceMappingOptions options;
+  options.method = MapMethod::normal;
+  const auto normal = morphomap::map_surfaces(s1.vertices, s1.faces, s2.vertices, s2.faces, options);
+  CHECK(morphomap::count_folds(normal.starts, normal.ends, normal.faces, s1.vertices, s1.faces, s2.vertices, s2.faces) >
+        0);
+  options.method = MapMethod::automatic;
+  const auto field = morphomap::map_surfaces(s1.vertices, s1.faces, s2.vertices, s2.faces, options);
+  CHECK(field.starts == s1.vertices);
+  CHECK(field.faces == s1.faces);
+  CHECK(morphomap::count_folds(field.starts, field.ends, field.faces, s1.vertices, s1.faces, s2.vertices, s2.faces) ==
+        0);
+  Index redone = 0;
+  for (Index i = 0; i < field.size(); ++i) {
+    CHECK(field.valid(i));
+    if (field.methods[static_cast<std::size_t>(i)] == Method::normal) {
+      CHECK(field.ends.row(i) == normal.ends.row(i));
+    } else {
+      CHECK(field.methods[static_cast<std::size_t>(i)] == Method::diffusion);
+      CHECK(s1.vertices(i, 2) > 0.5);  // near the pit, at the top
+      ++redone;
+    }
+  }
+  CHECK(redone > 0 && redone < field.size() / 4);
+}
+
 }  // namespace
 
 int main() {
@@ -175,5 +214,6 @@ int main() {
   stages_reported();
   sphere_to_ellipsoid();
   crossing_surfaces();
+  automatic_diffuses_near_a_bud_only();
   TEST_MAIN_END();
 }

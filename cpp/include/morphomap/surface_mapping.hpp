@@ -21,10 +21,13 @@ struct SurfaceMappingOptions {
   // diffusion: streamlines of Laplace's equation between the surfaces (solve_diffusion_3d); the
   //   ends are put onto their closest point of the target (the tetrahedral mesh only
   //   approximates it).
-  // automatic: normal mapping; if it misses anywhere or folds a triangle (count_folds), reverse
-  //   diffusion for the whole surface instead (methods tells which); where that fails (the
-  //   region cannot be meshed), diffusion, then the normal mapping if it missed nothing, then
-  //   minimal distance.
+  // automatic: normal mapping; if it misses anywhere or folds a triangle (count_folds), between
+  //   nested surfaces diffusion for the vertices within two mean gaps of those places (the mesh
+  //   coarser away from them), its ends blended into the normal ones over the outer gap, the
+  //   rest of the normal field kept (methods: normal, diffusion), if that has no fold; else (or
+  //   where more than half of the vertices would be redone) reverse diffusion for the whole
+  //   surface (rows and faces of the target); where that fails (the region cannot be meshed),
+  //   diffusion, then the normal mapping if it missed nothing, then minimal distance.
   // Only kSurfaceMethods: uniform and optimal have no 3D form (InvalidInput).
   MapMethod method = MapMethod::normal;
   bool reverse = false;              // map S2 -> S1 and flip: starts on S1, ends on S2, rows and faces of S2
@@ -32,8 +35,9 @@ struct SurfaceMappingOptions {
   bool diffusion_repeatable = true;  // ShellDiffusionOptions::repeatable
   // Called with the name of each stage as it begins, on the calling thread (a progress report);
   // may be empty. diffusion: "mesh", "solve", "trace" (ShellDiffusionOptions::on_stage).
-  // automatic: "normal", then, if it falls back, those three for each diffusion it tries (reverse,
-  // then forward where reverse fails: they can come twice). The other methods report nothing.
+  // automatic: "normal", then, if it falls back, those three for each diffusion it tries (local,
+  // whole-surface reverse, then forward: they can come up to three times). The other methods
+  // report nothing.
   std::function<void(const char* stage)> on_stage;
 };
 

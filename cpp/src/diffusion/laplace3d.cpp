@@ -40,6 +40,10 @@ using Vec4 = Eigen::Vector4d;
 constexpr double kSourceFraction = 0.02;
 constexpr double kFinestFraction = 0.01;
 constexpr int kMeshAttempts = 3;
+// Away from the part a local diffusion traces, the sizes grow by this times the distance beyond
+// its focus, up to kCoarsening times (bench/README.md, "A new bud, locally").
+constexpr double kFocusGrading = 0.25;
+constexpr double kCoarsening = 4.0;
 constexpr const char* kMeshing = "meshing the region between the surfaces";
 constexpr double kFacetDistanceNested = 0.2;
 constexpr double kFacetDistanceCrossing = 0.05;
@@ -417,7 +421,8 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
   return solution;
 }
 
-ShellDiffusionSolution detail::solve_diffusion_3d(const ShellPair& pair, const ShellDiffusionOptions& options) {
+ShellDiffusionSolution detail::solve_diffusion_3d(const ShellPair& pair, const ShellDiffusionOptions& options,
+                                                  const LocalDiffusion* local) {
   const Points3Ref& source_vertices = pair.source_vertices;
   const Points3Ref& target_vertices = pair.target_vertices;
   const SurfaceFacts source = measure_surface(source_vertices, pair.source_faces, pair.source_volume);
@@ -478,6 +483,13 @@ ShellDiffusionSolution detail::solve_diffusion_3d(const ShellPair& pair, const S
   criteria.grading = 0.1;
   criteria.exude = true;
   criteria.parallel = !options.repeatable && !crossing;
+  if (local != nullptr) {
+    if (crossing) throw GeometryError("diffusion for part of s1 needs nested surfaces");
+    criteria.focus = local->focus;
+    criteria.focus_radius = local->radius;
+    criteria.focus_grading = kFocusGrading;
+    criteria.coarsening = kCoarsening;
+  }
   // Between nested surfaces the boundary facets may stray a fifth of the element size from the
   // surfaces: at 0.05 Mesh_3 chased every crease of an unsmoothed marching-cubes surface (fuzz
   // seed 1882337550, a 2k-vertex swell pair: 917k tetrahedra, 128 s; at 0.2: 265k, 15 s), while
@@ -560,6 +572,10 @@ ShellDiffusionSolution detail::solve_diffusion_3d(const ShellPair& pair, const S
   Points3 exits(ns, 3);
   std::vector<std::vector<Vec3>> paths(options.keep_streamlines ? ns : 0);
   tbb::parallel_for(Index(0), ns, [&](Index i) {
+    if (local != nullptr && !local->traced[static_cast<std::size_t>(i)]) {
+      exits.row(i).setConstant(kNaN);
+      return;
+    }
     const Index t = source_facets[starts.faces[i]] / 4;
     std::vector<Vec3>* path = options.keep_streamlines ? &paths[i] : nullptr;
     if (path) path->push_back(source_vertices.row(i).transpose());

@@ -8,6 +8,8 @@
 
 #include "diffusion/shell_mesh.hpp"
 
+#include <vector>
+
 namespace morphomap::detail {
 
 // A source and a target that passed check_closed_surface with outward faces and require_volume
@@ -27,7 +29,18 @@ struct ShellPair {
   const SurfaceIndex& target_index;
 };
 
-// As the public solve_diffusion_3d on a pair checked as above, with options the caller checked.
-ShellDiffusionSolution solve_diffusion_3d(const ShellPair& pair, const ShellDiffusionOptions& options);
+// Diffusion wanted for some source vertices only (auto's local diffusion, nested surfaces): the
+// mesh as fine as usual within `radius` of the focus points and coarser away from them
+// (ShellMeshCriteria), and only the vertices with traced[i] traced (the other ends NaN).
+struct LocalDiffusion {
+  Points3 focus;
+  double radius = 0.0;
+  std::vector<char> traced;
+};
+
+// As the public solve_diffusion_3d on a pair checked as above, with options the caller checked;
+// with `local`, only that part (surfaces that cross: throws GeometryError).
+ShellDiffusionSolution solve_diffusion_3d(const ShellPair& pair, const ShellDiffusionOptions& options,
+                                          const LocalDiffusion* local = nullptr);
 
 }  // namespace morphomap::detail

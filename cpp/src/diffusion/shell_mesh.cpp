@@ -4,6 +4,7 @@
 // surfaces are first cut where they cross.
 #include "diffusion/shell_mesh.hpp"
 
+#include "common/nearest_point.hpp"
 #include "surfaces/surface_mesh.hpp"
 
 #include <morphomap/errors.hpp>
@@ -25,7 +26,6 @@
 #include <CGAL/make_mesh_3.h>
 #include <CGAL/refine_mesh_3.h>
 #include <boost/iterator/indirect_iterator.hpp>
-#include <nanoflann.hpp>
 
 #include <algorithm>
 #include <array>
@@ -35,6 +35,7 @@
 #include <memory>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 namespace morphomap::detail {
@@ -55,52 +56,17 @@ struct Mesh3 {
 using C3t3 = Mesh3<CGAL::Sequential_tag>::C3t3;
 using Criteria = Mesh3<CGAL::Sequential_tag>::Criteria;
 
-// The distance from a point to the nearest vertex of a surface. nanoflann's k-d tree, not CGAL's
-// Orthogonal_k_neighbor_search (a priority queue allocated per query): the meshing took ~5% less
-// time at 100k faces (bench/README.md). Both are exact and sum the squared coordinate
-// differences in the same order: the same distances.
-class NearestVertex {
- public:
-  // (The tree indexes the points when it is made: cloud_ is declared first.)
-  explicit NearestVertex(const SurfaceMesh& surface) : cloud_{points_of(surface)}, tree_(3, cloud_) {}
-  NearestVertex(const NearestVertex&) = delete;  // the tree refers to cloud_
-  NearestVertex& operator=(const NearestVertex&) = delete;
-
-  double distance(const Point& p) const {
-    const double query[3] = {p.x(), p.y(), p.z()};
-    std::uint32_t index = 0;
-    double squared = 0.0;
-    tree_.knnSearch(query, 1, &index, &squared);
-    return std::sqrt(squared);
+std::vector<std::array<double, 3>> points_of(const SurfaceMesh& surface) {
+  std::vector<std::array<double, 3>> points;
+  points.reserve(surface.number_of_vertices());
+  for (const auto v : surface.vertices()) {
+    const Point& p = surface.point(v);
+    points.push_back({p.x(), p.y(), p.z()});
   }
+  return points;
+}
 
- private:
-  // nanoflann's dataset interface.
-  struct Cloud {
-    std::vector<std::array<double, 3>> points;
-    std::size_t kdtree_get_point_count() const { return points.size(); }
-    double kdtree_get_pt(std::size_t i, std::size_t axis) const { return points[i][axis]; }
-    template <class Box>
-    bool kdtree_get_bbox(Box&) const {
-      return false;
-    }
-  };
-  static std::vector<std::array<double, 3>> points_of(const SurfaceMesh& surface) {
-    std::vector<std::array<double, 3>> points;
-    points.reserve(surface.number_of_vertices());
-    for (const auto v : surface.vertices()) {
-      const Point& p = surface.point(v);
-      points.push_back({p.x(), p.y(), p.z()});
-    }
-    return points;
-  }
-  using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>, Cloud, 3>;
-
-  Cloud cloud_;
-  Tree tree_;
-};
-
-// The distance to a surface's nearest vertex, interpolated trilinearly between the corners of a
+// The distance to the nearest of some points (a surface's vertices), interpolated trilinearly between the corners of a
 // grid, each corner searched once, on first use. Mesh_3 asks for the size millions of times (2.3
 // million searches at 100k faces were 27% of the meshing's CPU time, bench/README.md); the grid
 // needs one search per corner near the region. Each corner's value depends on its position alone
@@ -112,8 +78,8 @@ class NearestVertex {
 // a tenth of the meshing time at 100k faces: bench/README.md.)
 class GridDistance {
  public:
-  GridDistance(const SurfaceMesh& surface, const CGAL::Bbox_3& box, double spacing)
-      : exact_(surface), spacing_(spacing) {
+  GridDistance(std::vector<std::array<double, 3>> points, const CGAL::Bbox_3& box, double spacing)
+      : exact_(std::move(points)), spacing_(spacing) {
     const double lower[3] = {box.xmin(), box.ymin(), box.zmin()}, upper[3] = {box.xmax(), box.ymax(), box.zmax()};
     double extent = 0.0;
     for (int a = 0; a < 3; ++a) extent = std::max(extent, upper[a] - lower[a]);
@@ -132,13 +98,13 @@ class GridDistance {
   }
 
   double distance(const Point& p) const {
-    if (exact_only_) return exact_.distance(p);
+    if (exact_only_) return exact_.distance(p.x(), p.y(), p.z());
     const double at[3] = {p.x(), p.y(), p.z()};
     std::int64_t cell[3];
     double t[3];
     for (int a = 0; a < 3; ++a) {
       const double f = (at[a] - origin_[a]) / spacing_;
-      if (!(f >= 0.0 && f < static_cast<double>(count_[a] - 1))) return exact_.distance(p);
+      if (!(f >= 0.0 && f < static_cast<double>(count_[a] - 1))) return exact_.distance(p.x(), p.y(), p.z());
       cell[a] = static_cast<std::int64_t>(f);
       t[a] = f - static_cast<double>(cell[a]);
     }
@@ -164,15 +130,15 @@ class GridDistance {
     const std::size_t k = static_cast<std::size_t>((index[2] * count_[1] + index[1]) * count_[0] + index[0]);
     double value = corners_[k].load(std::memory_order_relaxed);
     if (value == kUnknown) {
-      value = exact_.distance(Point(origin_[0] + static_cast<double>(index[0]) * spacing_,
-                                    origin_[1] + static_cast<double>(index[1]) * spacing_,
-                                    origin_[2] + static_cast<double>(index[2]) * spacing_));
+      value = exact_.distance(origin_[0] + static_cast<double>(index[0]) * spacing_,
+                              origin_[1] + static_cast<double>(index[1]) * spacing_,
+                              origin_[2] + static_cast<double>(index[2]) * spacing_);
       corners_[k].store(value, std::memory_order_relaxed);
     }
     return value;
   }
 
-  NearestVertex exact_;
+  NearestPoint exact_;
   bool exact_only_ = false;
   double spacing_ = 0.0;
   double origin_[3] = {0.0, 0.0, 0.0};
@@ -182,19 +148,32 @@ class GridDistance {
 
 // Target edge length at a point: graded from the size at each surface with the distance to it,
 // the distance estimated by the nearest surface vertex (interpolated on a grid of twice that
-// size: GridDistance). Mesh_3 copies its sizing fields: the grids are shared (also by the parallel
-// mesher's threads).
+// size: GridDistance); coarser away from the focus points, if any. Mesh_3 copies its sizing
+// fields: the grids are shared (also by the parallel mesher's threads).
 class Sizing {
  public:
   Sizing(const SurfaceMesh& source, const SurfaceMesh& target, const ShellMeshCriteria& criteria)
       : criteria_(criteria) {
     const CGAL::Bbox_3 box = CGAL::Polygon_mesh_processing::bbox(source) + CGAL::Polygon_mesh_processing::bbox(target);
-    source_ = std::make_shared<const GridDistance>(source, box, kGridFraction * criteria.source_size);
-    target_ = std::make_shared<const GridDistance>(target, box, kGridFraction * criteria.target_size);
+    source_ = std::make_shared<const GridDistance>(points_of(source), box, kGridFraction * criteria.source_size);
+    target_ = std::make_shared<const GridDistance>(points_of(target), box, kGridFraction * criteria.target_size);
+    if (criteria.focus.rows() > 0) {
+      const double finest = std::min(criteria.source_size, criteria.target_size);
+      focus_ = std::make_shared<const GridDistance>(NearestPoint::rows(criteria.focus), box, kGridFraction * finest);
+    }
   }
 
   template <typename Index_>
   double operator()(const Point& p, int, const Index_&) const {
+    const double size = near_surfaces(p);
+    return size * coarsening(p, size);
+  }
+
+  // How many times coarser than near the surfaces the mesh may be at p (1 without focus points).
+  double coarsening(const Point& p) const { return focus_ ? coarsening(p, near_surfaces(p)) : 1.0; }
+
+ private:
+  double near_surfaces(const Point& p) const {
     const double ds = source_->distance(p);
     const double size = std::min(criteria_.cell_size, criteria_.source_size + criteria_.grading * ds);
     // Skip the second search where it cannot give less.
@@ -203,12 +182,34 @@ class Sizing {
     return std::min(size, criteria_.target_size + criteria_.grading * dt);
   }
 
- private:
+  double coarsening(const Point& p, double size) const {
+    if (!focus_) return 1.0;
+    const double beyond = focus_->distance(p) - criteria_.focus_radius;
+    if (!(beyond > 0.0)) return 1.0;
+    return std::min(criteria_.coarsening, 1.0 + criteria_.focus_grading * beyond / size);
+  }
+
   // The grids' spacing, in sizes at their surface (bench/README.md, session 10: at 3 and 4 the
   // concentric spheres' RMS grew by 4-7%; at 1 the corners cost as much as the searches saved).
   static constexpr double kGridFraction = 2.0;
-  std::shared_ptr<const GridDistance> source_, target_;
+  std::shared_ptr<const GridDistance> source_, target_, focus_;
   ShellMeshCriteria criteria_;
+};
+
+// The largest distance between a boundary facet and the surface: the criteria's, as coarse as the
+// sizes away from the focus points.
+class FacetDistance {
+ public:
+  FacetDistance(const Sizing& sizing, double distance) : sizing_(sizing), distance_(distance) {}
+
+  template <typename Index_>
+  double operator()(const Point& p, int, const Index_&) const {
+    return distance_ * sizing_.coarsening(p);
+  }
+
+ private:
+  Sizing sizing_;
+  double distance_;
 };
 
 // A few vertices of a surface (every n/20-th) inserted as points of its patch.
@@ -360,8 +361,9 @@ ShellMesh mesh_nested(const ClosedSurface& source, const ClosedSurface& target, 
                         sides + 2, &random);
     namespace params = CGAL::parameters;
     const typename Mesh3<Concurrency>::Criteria mesh_criteria(
-        params::facet_angle = 25.0, params::facet_size = sizing, params::facet_distance = criteria.facet_distance,
-        params::cell_radius_edge_ratio = 3.0, params::cell_size = sizing);
+        params::facet_angle = 25.0, params::facet_size = sizing,
+        params::facet_distance = FacetDistance(sizing, criteria.facet_distance), params::cell_radius_edge_ratio = 3.0,
+        params::cell_size = sizing);
     // Mesh_3's own initial points come from rays shot from the centre of the bounding box and may
     // all land on the outer surface, so that the inner one is never found: start instead from a
     // few vertices of each surface, as points of its patch.

@@ -60,6 +60,13 @@ struct ShellMeshCriteria {
   // Mesh_3's parallel mode on all cores (nested surfaces only; crossing ones mesh sequentially):
   // faster, but the mesh differs from run to run.
   bool parallel = false;
+  // Coarser away from a region (nested surfaces only: auto's local diffusion). Farther than
+  // focus_radius from every focus point, the sizes above and facet_distance grow by focus_grading
+  // times the distance beyond it, up to `coarsening` times. No focus points: as above everywhere.
+  Points3 focus;
+  double focus_radius = 0.0;
+  double focus_grading = 0.0;
+  double coarsening = 1.0;
 };
 
 enum FacePatch : signed char { interior_face = 0, source_face = 1, target_face = 2, other_face = -1 };

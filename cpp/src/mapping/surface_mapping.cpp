@@ -1,13 +1,13 @@
 // The paper's 3D mapping: minimal distance, normal and diffusion mapping of the vertices of one
-// closed surface onto another, with reverse and "auto" (normal, else reverse diffusion).
+// closed surface onto another, with reverse and "auto" (normal, else diffusion where it fails).
 #include <morphomap/laplace3d.hpp>
-#include <morphomap/quality.hpp>
 #include <morphomap/surface_mapping.hpp>
 #include <morphomap/surface_queries.hpp>
 
 #include "common/validation.hpp"
 #include "diffusion/shell_diffusion.hpp"
 #include "diffusion/shell_mesh.hpp"
+#include "mapping/local_diffusion.hpp"
 #include "quality/folds.hpp"
 
 #include <morphomap/errors.hpp>
@@ -17,6 +17,7 @@
 #include <iterator>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -49,6 +50,14 @@ const SurfaceIndex& index_of(const Surface& surface, std::unique_ptr<SurfaceInde
   return *built;
 }
 
+// The pair as diffusion takes it.
+detail::ShellPair shell_pair(const Pair& pair, const SurfaceIndex& target_index) {
+  const Surface& source = pair.source;
+  const Surface& target = pair.target;
+  return detail::ShellPair{source.vertices, source.faces,  target.vertices, target.faces, *source.closed,
+                           *target.closed,  source.volume, target.volume,   pair.nesting, target_index};
+}
+
 // Vectors from the vertices of `pair.source` to `pair.target` (queried through `target_index`,
 // built from it) with one basic algorithm; diffusion with `diffusion`'s options. Diffusion's fold
 // repair also queries the source: through `source_index` where the caller has one, else through
@@ -72,10 +81,7 @@ DisplacementField3 basic(MapMethod method, const Pair& pair, const SurfaceIndex&
       break;
     }
     case MapMethod::diffusion: {
-      const ShellDiffusionSolution solution = detail::solve_diffusion_3d(
-          detail::ShellPair{source.vertices, source.faces, target.vertices, target.faces, *source.closed,
-                            *target.closed, source.volume, target.volume, pair.nesting, target_index},
-          diffusion);
+      const ShellDiffusionSolution solution = detail::solve_diffusion_3d(shell_pair(pair, target_index), diffusion);
       if (solution.ends.rows() != field.size())
         throw GeometryError("diffusion: the solver returned the wrong number of ends");
       field.ends = solution.ends;  // on the target itself (solve_diffusion_3d puts them there)
@@ -119,10 +125,11 @@ bool complete(const DisplacementField3& field) {
   return true;
 }
 
-// "auto": normal mapping where it misses nothing and folds no triangle; else reverse diffusion
-// (the paper's choice), else diffusion (both fold-free by construction), else the normal mapping
-// if it missed nothing, else minimal distance (which always finds a point): it answers wherever a
-// basic algorithm does.
+// "auto": normal mapping where it misses nothing and folds no triangle; else, between nested
+// surfaces, the normal field with diffusion near where it failed (local_diffusion.hpp); else
+// reverse diffusion over the whole surface (the paper's choice), else diffusion (both fold-free
+// by construction), else the normal mapping if it missed nothing, else minimal distance (which
+// always finds a point): it answers wherever a basic algorithm does.
 DisplacementField3 automatic(const Pair& pair, const SurfaceIndex& target_index,
                              const ShellDiffusionOptions& diffusion) {
   const Surface& source = pair.source;
@@ -132,14 +139,23 @@ DisplacementField3 automatic(const Pair& pair, const SurfaceIndex& target_index,
   std::unique_ptr<SurfaceIndex> built;
   const SurfaceIndex& source_index = index_of(source, built);
   const bool missed = !complete(normal);
-  if (!missed && count_folds(normal.starts, normal.ends, normal.faces, source.vertices, source.faces, source_index,
-                             target.vertices, target.faces, target_index) == 0) {
-    return normal;
-  }
+  const std::vector<char> folded = detail::FoldTest(normal.starts, normal.faces, source.vertices, source.faces,
+                                                    source_index, target.vertices, target.faces, target_index)
+                                       .folded(normal.ends);
+  if (!missed && std::find(folded.begin(), folded.end(), 1) == folded.end()) return normal;
   // Diffusion needs a region between the surfaces; where one of them encloses no volume the
   // attempts would be refused (require_volume), so they are not made.
   const bool diffusable = detail::encloses_volume(source.volume, source.vertices) &&
                           detail::encloses_volume(target.volume, target.vertices);
+  if (diffusable && pair.nesting != detail::Nesting::crossing) {
+    try {
+      std::optional<DisplacementField3> field =
+          detail::normal_with_local_diffusion(normal, folded, shell_pair(pair, target_index), source_index, diffusion);
+      if (field) return std::move(*field);
+    } catch (const GeometryError&) {
+    } catch (const InvalidInput&) {  // surfaces whose region diffusion cannot mesh (they coincide in part, say)
+    }
+  }
   for (const bool backwards : {true, false}) {
     if (!diffusable) break;
     try {
