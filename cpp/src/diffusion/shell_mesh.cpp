@@ -66,16 +66,16 @@ std::vector<std::array<double, 3>> points_of(const SurfaceMesh& surface) {
   return points;
 }
 
-// The distance to the nearest of some points (a surface's vertices), interpolated trilinearly between the corners of a
-// grid, each corner searched once, on first use. Mesh_3 asks for the size millions of times (2.3
-// million searches at 100k faces were 27% of the meshing's CPU time, bench/README.md); the grid
-// needs one search per corner near the region. Each corner's value depends on its position alone
-// (whichever thread fills it first), so the mesh stays repeatable. The distance is 1-Lipschitz:
-// interpolated, it errs by less than the spacing times sqrt(3), and the size by the grading times
-// that (a third of the finest size at the spacing Sizing uses). Outside the grid: the exact search.
-// (Session 10 kept the search exact within two spacings of the surface, because one real frame's
-// field then kept a fold; the fold repair now removes it, and interpolating there too saves about
-// a tenth of the meshing time at 100k faces: bench/README.md.)
+// The distance to the nearest of some points (a surface's vertices), interpolated trilinearly
+// between the corners of a grid, each corner searched once, on first use. Mesh_3 asks for the size
+// millions of times (2.3 million searches at 100k faces were 27% of the meshing's CPU time,
+// bench/README.md); the grid needs one search per corner near the region. Each corner's value
+// depends on its position alone (whichever thread fills it first), so the mesh stays repeatable.
+// The distance is 1-Lipschitz: interpolated, it errs by less than the spacing times sqrt(3), and
+// the size by the grading times that (a third of the finest size at the spacing Sizing uses).
+// Outside the grid: the exact search. (Session 10 kept the search exact within two spacings of the
+// surface, because one real frame's field then kept a fold; the fold repair now removes it, and
+// interpolating there too saves about a tenth of the meshing time at 100k faces: bench/README.md.)
 class GridDistance {
  public:
   GridDistance(std::vector<std::array<double, 3>> points, const CGAL::Bbox_3& box, double spacing)

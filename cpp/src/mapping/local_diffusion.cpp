@@ -6,8 +6,7 @@
 
 #include "common/nearest_point.hpp"
 #include "quality/folds.hpp"
-
-#include <Eigen/Geometry>
+#include "surfaces/surface_util.hpp"
 
 #include <algorithm>
 #include <array>
@@ -31,15 +30,6 @@ constexpr double kMostShare = 0.5;
 // many gaps long only spaces them further).
 constexpr double kMostSteps = 64.0;
 
-double area(const Points3Ref& vertices, const FacesRef& faces) {
-  double sum = 0.0;
-  for (Index f = 0; f < faces.rows(); ++f) {
-    const Eigen::Vector3d a = vertices.row(faces(f, 0)), b = vertices.row(faces(f, 1)), c = vertices.row(faces(f, 2));
-    sum += 0.5 * (b - a).cross(c - a).norm();
-  }
-  return sum;
-}
-
 }  // namespace
 
 std::optional<DisplacementField3> normal_with_local_diffusion(const DisplacementField3& normal,
@@ -60,9 +50,9 @@ std::optional<DisplacementField3> normal_with_local_diffusion(const Displacement
   }
   if (seeds.empty()) return std::nullopt;
 
-  const double gap =
-      std::abs(pair.target_volume - pair.source_volume) /
-      (0.5 * (area(pair.source_vertices, pair.source_faces) + area(pair.target_vertices, pair.target_faces)));
+  const double gap = std::abs(pair.target_volume - pair.source_volume) /
+                     (0.5 * (surface_area(pair.source_vertices, pair.source_faces) +
+                             surface_area(pair.target_vertices, pair.target_faces)));
   if (!(gap > 0.0) || !std::isfinite(gap)) return std::nullopt;
   const double inner = kInner * gap, outer = (kInner + kBand) * gap;
   const NearestPoint nearest(std::move(seeds));

@@ -45,15 +45,6 @@ void require_field_faces(const FacesRef& faces, Index rows, const char* name) {
   }
 }
 
-double surface_area(const Points3Ref& v, const FacesRef& f) {
-  double area = 0.0;
-  for (Index j = 0; j < f.rows(); ++j) {
-    const V3 a = detail::corner(v, f, j, 0);
-    area += 0.5 * (detail::corner(v, f, j, 1) - a).cross(detail::corner(v, f, j, 2) - a).norm();
-  }
-  return area;
-}
-
 double tetrahedron(const V3& a, const V3& b, const V3& c, const V3& d) {
   return std::abs((b - a).dot((c - a).cross(d - a))) / 6.0;
 }
@@ -206,7 +197,7 @@ SurfaceQuality checked_quality(const DisplacementField3& field, const Points3Ref
   require_on(field.starts, v1, index1, "start point");
   require_on(field.ends, v2, index2, "end point");
 
-  const double alpha = surface_area(v2, f2) / surface_area(v1, f1);
+  const double alpha = detail::surface_area(v2, f2) / detail::surface_area(v1, f1);
   const Index count = field.faces.rows();
   std::vector<double> ratio(count, kNaN), volume(count, kNaN);
   for (Index j = 0; j < count; ++j) {

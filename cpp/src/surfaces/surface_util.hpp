@@ -22,6 +22,16 @@ void require_face_indices(const FacesRef& faces, Index vertex_count, const char*
 
 inline V3 corner(const Points3Ref& v, const FacesRef& f, Index face, int k) { return v.row(f(face, k)).transpose(); }
 
+// The area of a triangle surface: the sum of its faces' areas.
+inline double surface_area(const Points3Ref& v, const FacesRef& f) {
+  double area = 0.0;
+  for (Index j = 0; j < f.rows(); ++j) {
+    const V3 a = corner(v, f, j, 0);
+    area += 0.5 * (corner(v, f, j, 1) - a).cross(corner(v, f, j, 2) - a).norm();
+  }
+  return area;
+}
+
 // Closest point to p on triangle abc (Ericson, "Real-Time Collision Detection" 5.1.5: walk the
 // Voronoi regions of the vertices, edges and face); exact for degenerate triangles too.
 inline V3 closest_on_triangle(const V3& p, const V3& a, const V3& b, const V3& c) {
