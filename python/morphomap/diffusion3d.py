@@ -64,10 +64,10 @@ def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False, progress=No
     mesh_size : float, optional
         Largest tetrahedron size. Default: a quarter of the mean gap (the region's volume over the
         mean area of the surfaces); in a thin shell, where that is finer than half the surfaces'
-        spacing (mean edge, or 1% of the diagonal if larger), half that spacing but at most half
+        spacing (mean edge, or 1.5% of the diagonal if larger), half that spacing but at most half
         the gap (frames a voxel apart: 8x fewer tetrahedra, see bench/README.md). Near each
         surface the mesh follows its mean edge length (or ``mesh_size`` if smaller), but no finer
-        than 1% of the surface's bounding diagonal (where the surface curves more tightly, the
+        than 1.5% of the surface's bounding diagonal (where the surface curves more tightly, the
         boundary facets still follow it to a fifth of that size), and grows by a tenth of the
         distance away from it.
     streamlines : bool

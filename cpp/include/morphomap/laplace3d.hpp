@@ -11,8 +11,8 @@ struct ShellDiffusionOptions {
   // Largest tetrahedron size (CGAL Mesh_3 cell size); 0: a quarter of the mean gap between the
   // surfaces (the region's volume over the mean of their areas), or in a thin shell, where that
   // is finer than half the surfaces' spacing, half that spacing but at most half the gap. Near
-  // each surface the mesh follows its mean edge length (or mesh_size, if smaller) and grows away
-  // from it by a tenth of the distance.
+  // each surface the mesh follows its mean edge length (or mesh_size, if smaller), but no finer
+  // than 1.5% of the surface's bounding diagonal, and grows away from it by a tenth of the distance.
   double mesh_size = 0.0;
   // true: the same input gives the same mesh, potential and ends, bit for bit, in any process and
   // on any number of threads (Mesh_3 on one core). false: Mesh_3's parallel mode on all cores,

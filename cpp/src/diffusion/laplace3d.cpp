@@ -38,7 +38,8 @@ namespace {
 using Vec3 = Eigen::Vector3d;
 using Vec4 = Eigen::Vector4d;
 constexpr double kSourceFraction = 0.02;
-constexpr double kFinestFraction = 0.01;
+// The finest element size near a surface, as a fraction of its bounding diagonal (below).
+constexpr double kFinestFraction = 0.015;
 constexpr int kMeshAttempts = 3;
 // Away from the part a local diffusion traces, the sizes grow by this times the distance beyond
 // its focus, up to kCoarsening times (bench/README.md, "A new bud, locally").
@@ -463,14 +464,16 @@ ShellDiffusionSolution detail::solve_diffusion_3d(const ShellPair& pair, const S
   const double volume = crossing ? crossing->volume() : std::abs(target.volume - source.volume);
   // Where the surfaces touch, they bound no region: leave that part out of the mean.
   const double gap = volume / std::max(0.5 * (source.area + target.area) - cleared.near_area, 0.05 * source.area);
-  // The input spacing: the mean edge, but not finer than 1% of a surface's diagonal: a finer
+  // The input spacing: the mean edge, but not finer than 1.5% of a surface's diagonal: a finer
   // spacing describes the surface, not a shape the field must resolve (where the surface curves,
   // facet_distance refines), and following it made the mesh grow with the surfaces' resolution
-  // (five times the tetrahedra, eight times the time, for a lumpy pair of 100k faces;
-  // bench/README.md). Near the source, where the streamlines start, the elements stay within a
-  // fraction of the source's size however coarse its triangles are (the end error follows the
-  // element size there: concentric spheres r = 1 -> 4 with 642 vertices gave RMS 0.018 at the
-  // triangles' size).
+  // (five times the tetrahedra, eight times the time, for a lumpy pair of 100k faces). 1.5%
+  // rather than 1%: an organ pair's ends then move by about a quarter of a percent of the gap from
+  // a much finer mesh's, less than the concentric spheres' row errs by, with fewer than half the
+  // tetrahedra (bench/README.md, session 14). Near the source, where the streamlines start, the
+  // elements stay within a fraction of the source's size however coarse its triangles are (the end
+  // error follows the element size there: concentric spheres r = 1 -> 4 with 642 vertices gave
+  // RMS 0.018 at the triangles' size).
   const double source_diagonal = (source_vertices.colwise().maxCoeff() - source_vertices.colwise().minCoeff()).norm();
   const double target_diagonal = (target_vertices.colwise().maxCoeff() - target_vertices.colwise().minCoeff()).norm();
   const double source_spacing = std::max(source.mean_edge, kFinestFraction * source_diagonal);
