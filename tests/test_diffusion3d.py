@@ -239,7 +239,7 @@ def test_a_coarse_inner_sphere_is_as_accurate_by_default():
 
 
 def test_finely_triangulated_spheres_mesh_to_their_shape_not_to_their_triangles():
-    # 10242 vertices each (mean edges 0.019 and 0.076): the mesh near each surface stops at 1.5% of
+    # 10242 vertices each (mean edges 0.038 and 0.15): the mesh near each surface stops at 1.5% of
     # its diagonal (0.052 and 0.21). At 1% it had 408k tetrahedra and an RMS end error of 4.9e-3;
     # now 228k and 5.9e-3, below the 2562-vertex default row's 7.9e-3 (bench/README.md, session 14).
     inner, outer = sphere(1.0, 5), sphere(4.0, 5)
