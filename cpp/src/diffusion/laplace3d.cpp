@@ -14,6 +14,7 @@
 #include "diffusion/mesh_in_child.hpp"
 #include "diffusion/shell_diffusion.hpp"
 #include "diffusion/shell_mesh.hpp"
+#include "surfaces/surface_util.hpp"
 
 #include <tbb/parallel_for.h>
 #include <Eigen/Dense>
@@ -70,10 +71,10 @@ struct SurfaceFacts {
 SurfaceFacts measure_surface(const Points3Ref& vertices, const FacesRef& faces, double volume) {
   SurfaceFacts facts;
   facts.volume = volume;
+  facts.area = detail::surface_area(vertices, faces);
   for (Index f = 0; f < faces.rows(); ++f) {
-    const Vec3 a = vertices.row(faces(f, 0)).transpose(), b = vertices.row(faces(f, 1)).transpose(),
-               c = vertices.row(faces(f, 2)).transpose();
-    facts.area += 0.5 * (b - a).cross(c - a).norm();
+    const Vec3 a = detail::corner(vertices, faces, f, 0), b = detail::corner(vertices, faces, f, 1),
+               c = detail::corner(vertices, faces, f, 2);
     facts.mean_edge += ((b - a).norm() + (c - b).norm() + (a - c).norm()) / 3.0;
   }
   facts.mean_edge /= faces.rows();
