@@ -28,6 +28,15 @@ def angular_rms(starts, ends, radius):
     return radius * np.sqrt(np.mean(angles**2))
 
 
+def radial_default(inner, radius):
+    """Diffusion at the default settings from `inner` onto the same triangulation scaled to `radius`:
+    the solution (every streamline must arrive) and its RMS end error (angular_rms)."""
+    outer = (inner[0] * radius, inner[1])
+    solution = mm.solve_diffusion_3d(inner, outer)
+    assert np.isfinite(solution.ends).all()
+    return solution, angular_rms(inner[0], solution.ends, radius)
+
+
 @pytest.fixture(scope="module")
 def spheres():
     inner, outer = sphere(1.0), sphere(4.0)
@@ -232,34 +241,29 @@ def test_a_surface_enclosing_no_volume_is_named_whichever_way_diffusion_runs():
 def test_a_coarse_inner_sphere_is_as_accurate_by_default():
     # 642 vertices (icosphere 3) inside and out: the mesh near S1 is sized from S1's extent, not
     # from its coarse triangles (at their size the RMS end error was 0.018).
-    inner, outer = sphere(1.0, 3), sphere(4.0, 3)
-    solution = mm.solve_diffusion_3d(inner, outer)
-    assert np.isfinite(solution.ends).all()
-    assert angular_rms(inner[0], solution.ends, 4.0) < 0.01
+    _, rms = radial_default(sphere(1.0, 3), 4.0)
+    assert rms < 0.01
 
 
 def test_finely_triangulated_spheres_mesh_to_their_shape_not_to_their_triangles():
     # 10242 vertices each (mean edges 0.038 and 0.15): the mesh near each surface stops at 1.5% of
     # its diagonal (0.052 and 0.21). At 1% it had 408k tetrahedra and an RMS end error of 4.9e-3;
     # now 228k and 5.9e-3, below the 2562-vertex default row's 7.9e-3 (bench/README.md, session 14).
-    inner, outer = sphere(1.0, 5), sphere(4.0, 5)
-    solution = mm.solve_diffusion_3d(inner, outer)
+    solution, rms = radial_default(sphere(1.0, 5), 4.0)
     assert len(solution.tetrahedra) < 300_000, len(solution.tetrahedra)
-    assert np.isfinite(solution.ends).all()
-    assert angular_rms(inner[0], solution.ends, 4.0) < 7.0e-3
+    assert rms < 7.0e-3
 
 
 def test_a_thin_shell_meshes_to_its_surfaces_spacing_not_to_a_quarter_of_its_gap():
     # Spheres of radii 1 and 1.1 with 642 vertices (mean edge 0.15-0.17, mean gap 0.1): a quarter
     # of the gap is six times finer than the triangles and gave ~380k tetrahedra; the default is
     # now half the gap (two elements across), and the streamlines stay radial to 1% of the gap.
-    inner, outer = sphere(1.0, 3), sphere(1.1, 3)
-    solution = mm.solve_diffusion_3d(inner, outer)
+    inner = sphere(1.0, 3)
+    solution, rms = radial_default(inner, 1.1)
     assert len(solution.tetrahedra) < 100_000, len(solution.tetrahedra)
-    assert np.isfinite(solution.ends).all()
-    assert angular_rms(inner[0], solution.ends, 1.1) < 1e-3
+    assert rms < 1e-3
     field = mm.DisplacementField(inner[0], solution.ends, np.full(len(inner[0]), "diffusion"), faces=inner[1])
-    assert mm.quality(field, inner, outer).folds == 0
+    assert mm.quality(field, inner, sphere(1.1, 3)).folds == 0
 
 
 _REPEAT_SCRIPT = """
