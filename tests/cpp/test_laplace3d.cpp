@@ -168,6 +168,30 @@ void bad_input() {
   CHECK_THROWS(solve_diffusion_3d(a.vertices, a.faces, b.vertices, b.faces, negative), InvalidInput);
 }
 
+// Both surfaces are checked at once, but when both are bad the error is s1's, as it was when they
+// were checked one after the other: s1 is the larger (slower to check) of the two.
+void both_bad_reports_s1() {
+  const auto reported = [](const Surface& s1, const Surface& s2) {
+    try {
+      solve_diffusion_3d(s1.vertices, s1.faces, s2.vertices, s2.faces);
+    } catch (const InvalidInput& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  Surface open1 = scaled(icosphere(4), 3, 3, 3), open2 = icosphere(1);
+  open1.faces.conservativeResize(open1.faces.rows() - 1, 3);
+  open2.faces.conservativeResize(open2.faces.rows() - 1, 3);
+  Surface crossing1 = scaled(icosphere(4), 3, 3, 3), crossing2 = icosphere(1);
+  crossing1.vertices.row(0) *= -1.5;  // a spike through the far side
+  crossing2.vertices.row(0) *= -1.5;
+  for (int run = 0; run < 10; ++run) {
+    const std::string unclosed = reported(open1, open2), meeting = reported(crossing1, crossing2);
+    CHECK(unclosed.rfind("s1", 0) == 0 && unclosed.find("not closed") != std::string::npos);
+    CHECK(meeting.rfind("s1: intersects itself", 0) == 0);
+  }
+}
+
 // S1 a sphere with a pit, S2 1.15 times the sphere with a bud over it: normal mapping folds at the
 // pit only, so "auto" keeps the normal vectors elsewhere and diffuses near the pit.
 void automatic_diffuses_near_a_bud_only() {
@@ -209,6 +233,7 @@ void automatic_diffuses_near_a_bud_only() {
 
 int main() {
   bad_input();
+  both_bad_reports_s1();
   concentric_spheres();
   inwards_and_flipped();
   stages_reported();

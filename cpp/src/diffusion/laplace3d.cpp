@@ -8,6 +8,7 @@
 #include "common/finite_rows.hpp"
 #include "common/interrupt_check.hpp"
 #include "common/numbers.hpp"
+#include "common/run_both.hpp"
 #include "common/validation.hpp"
 #include "diffusion/contact3d.hpp"
 #include "diffusion/dirichlet.hpp"
@@ -206,18 +207,7 @@ class Tracer {
   // gradient at the vertex is second-order accurate. The mean stays where the fit is singular.
   void recover_by_least_squares(const Vector& c) {
     const Index n = mesh_.vertices.rows();
-    std::vector<std::vector<Index>> ring(n);
-    for (Index t = 0; t < mesh_.tetrahedra.rows(); ++t) {
-      for (int i = 0; i < 4; ++i) {
-        for (int j = 0; j < 4; ++j) {
-          if (i != j) ring[mesh_.tetrahedra(t, i)].push_back(mesh_.tetrahedra(t, j));
-        }
-      }
-    }
-    for (auto& r : ring) {
-      std::sort(r.begin(), r.end());
-      r.erase(std::unique(r.begin(), r.end()), r.end());
-    }
+    const std::vector<std::vector<Index>> ring = neighbour_rings();
     tbb::parallel_for(Index(0), n, [&](Index v) {
       std::vector<Index> patch = ring[v];
       if (patch.size() < 14) {
@@ -247,6 +237,34 @@ class Tracer {
       if (!x.allFinite()) return;
       velocity_[v] = -x.head<3>() / h;
     });
+  }
+
+  // The vertices that share a tetrahedron with each vertex, sorted: gathered from each vertex's
+  // tetrahedra (listed first), so that the rings are filled on all cores.
+  std::vector<std::vector<Index>> neighbour_rings() const {
+    const Index n = mesh_.vertices.rows(), tets = mesh_.tetrahedra.rows();
+    std::vector<Index> first(n + 1, 0);
+    for (Index t = 0; t < tets; ++t) {
+      for (int i = 0; i < 4; ++i) ++first[mesh_.tetrahedra(t, i) + 1];
+    }
+    for (Index v = 0; v < n; ++v) first[v + 1] += first[v];
+    std::vector<Index> incident(first[n]), next(first.begin(), first.end() - 1);
+    for (Index t = 0; t < tets; ++t) {
+      for (int i = 0; i < 4; ++i) incident[next[mesh_.tetrahedra(t, i)]++] = t;
+    }
+    std::vector<std::vector<Index>> ring(n);
+    tbb::parallel_for(Index(0), n, [&](Index v) {
+      std::vector<Index>& r = ring[v];
+      for (Index k = first[v]; k < first[v + 1]; ++k) {
+        for (int j = 0; j < 4; ++j) {
+          const Index w = mesh_.tetrahedra(incident[k], j);
+          if (w != v) r.push_back(w);
+        }
+      }
+      std::sort(r.begin(), r.end());
+      r.erase(std::unique(r.begin(), r.end()), r.end());
+    });
+    return ring;
   }
 
   // From the gradients of the barycentric coordinates, kept from the constructor: a streamline
@@ -398,26 +416,34 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
     detail::invalid("mesh_size", "must be a finite length >= 0");
   }
   const auto clock = std::chrono::steady_clock::now();
-  const double source_volume = check_closed_surface(source_vertices, source_faces, "s1");
-  const double target_volume = check_closed_surface(target_vertices, target_faces, "s2");
-  detail::require_volume(std::abs(source_volume), source_vertices, "s1");
-  detail::require_volume(std::abs(target_volume), target_vertices, "s2");
-  // Mesh_3 and the nesting tests want outward orientation.
-  Faces source_out = source_faces, target_out = target_faces;
-  if (source_volume < 0.0) source_out.col(1).swap(source_out.col(2));
-  if (target_volume < 0.0) target_out.col(1).swap(target_out.col(2));
-  // Each surface in CGAL's form once, for the nesting, contact, crossing and meshing steps.
-  const detail::ClosedSurface source(source_vertices, source_out);
-  const detail::ClosedSurface target(target_vertices, target_out);
-  const detail::Nesting nesting = detail::classify_nesting(source, target);
+  // Each surface checked, oriented outwards (Mesh_3 and the nesting tests want that) and put in
+  // CGAL's form once, for the nesting, contact, crossing and meshing steps: the two at once.
+  struct Checked {
+    double volume = 0.0;
+    Faces outward;
+    std::unique_ptr<const detail::ClosedSurface> closed;
+  };
+  const auto check = [](const Points3Ref& vertices, const FacesRef& faces, const char* name) {
+    Checked checked;
+    checked.volume = check_closed_surface(vertices, faces, name);
+    detail::require_volume(std::abs(checked.volume), vertices, name);
+    checked.outward = faces;
+    if (checked.volume < 0.0) checked.outward.col(1).swap(checked.outward.col(2));
+    checked.closed = std::make_unique<const detail::ClosedSurface>(vertices, checked.outward);
+    return checked;
+  };
+  Checked source, target;
+  detail::run_both([&] { source = check(source_vertices, source_faces, "s1"); },
+                   [&] { target = check(target_vertices, target_faces, "s2"); });
+  const detail::Nesting nesting = detail::classify_nesting(*source.closed, *target.closed);
   if (nesting == detail::Nesting::disjoint) {
     throw InvalidInput("s2: diffusion mapping needs surfaces that overlap (these lie apart)");
   }
-  const SurfaceIndex target_index(target_vertices, target_out);
+  const SurfaceIndex target_index(target_vertices, target.outward);
   const double nesting_seconds = seconds_since(clock);
   ShellDiffusionSolution solution = detail::solve_diffusion_3d(
-      detail::ShellPair{source_vertices, source_out, target_vertices, target_out, source, target,
-                        std::abs(source_volume), std::abs(target_volume), nesting, target_index},
+      detail::ShellPair{source_vertices, source.outward, target_vertices, target.outward, *source.closed,
+                        *target.closed, std::abs(source.volume), std::abs(target.volume), nesting, target_index},
       options);
   solution.seconds.mesh += nesting_seconds;  // the nesting test is part of the meshing stage
   return solution;

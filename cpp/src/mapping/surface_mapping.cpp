@@ -4,6 +4,7 @@
 #include <morphomap/surface_mapping.hpp>
 #include <morphomap/surface_queries.hpp>
 
+#include "common/run_both.hpp"
 #include "common/validation.hpp"
 #include "diffusion/shell_diffusion.hpp"
 #include "diffusion/shell_mesh.hpp"
@@ -197,8 +198,7 @@ DisplacementField3 checked(Surface s1, Surface s2, const SurfaceMappingOptions& 
     detail::require_volume(s2.volume, s2.vertices, "s2");
   }
   std::unique_ptr<const detail::ClosedSurface> built1, built2;
-  s1.closed = &closed_of(s1, built1);
-  s2.closed = &closed_of(s2, built2);
+  detail::run_both([&] { s1.closed = &closed_of(s1, built1); }, [&] { s2.closed = &closed_of(s2, built2); });
   // Both surfaces free of self-intersections (classify_nesting checks), and overlapping: frames
   // of one organ do (see map_curves).
   const detail::Nesting nesting = detail::classify_nesting(*s1.closed, *s2.closed);
@@ -223,10 +223,16 @@ DisplacementField3 checked(Surface s1, Surface s2, const SurfaceMappingOptions& 
 
 DisplacementField3 map_surfaces(const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2,
                                 const SurfaceMappingOptions& options) {
-  const double volume1 = check_closed_surface(v1, f1, "s1");
-  detail::require_outward(volume1, "s1");
-  const double volume2 = check_closed_surface(v2, f2, "s2");
-  detail::require_outward(volume2, "s2");
+  double volume1 = 0.0, volume2 = 0.0;
+  detail::run_both(
+      [&] {
+        volume1 = check_closed_surface(v1, f1, "s1");
+        detail::require_outward(volume1, "s1");
+      },
+      [&] {
+        volume2 = check_closed_surface(v2, f2, "s2");
+        detail::require_outward(volume2, "s2");
+      });
   return checked(Surface{v1, f1, volume1}, Surface{v2, f2, volume2}, options);
 }
 

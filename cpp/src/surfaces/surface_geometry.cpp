@@ -112,16 +112,16 @@ double check_closed_surface(const Points3Ref& vertices, const FacesRef& faces, c
     for (int k = 0; k < 3; ++k) edges.emplace_back(faces(j, k), faces(j, (k + 1) % 3));
   }
   tbb::parallel_sort(edges.begin(), edges.end());
+  const auto edge = [](Index a, Index b) { return "edge (" + std::to_string(a) + ", " + std::to_string(b) + ")"; };
   for (std::size_t e = 0; e < edges.size(); ++e) {
     const auto [a, b] = edges[e];
-    const std::string edge = "(" + std::to_string(a) + ", " + std::to_string(b) + ")";
     if (e + 1 < edges.size() && edges[e + 1] == edges[e]) {
-      detail::invalid(name, "edge " + edge +
+      detail::invalid(name, edge(a, b) +
                                 " is used twice in the same direction: the faces are not "
                                 "consistently oriented, or more than two faces meet at the edge");
     }
     if (!std::binary_search(edges.begin(), edges.end(), std::make_pair(b, a))) {
-      detail::invalid(name, "the surface is not closed: edge " + edge +
+      detail::invalid(name, "the surface is not closed: " + edge(a, b) +
                                 " belongs to one face only "
                                 "(or its neighbour is oriented the other way)");
     }
