@@ -16,7 +16,8 @@
    peak memory, beside the pipeline a user would assemble: TetGen (PyPI `tetgen`, AGPL: measured
    only, never a dependency) meshing the shell with quality switches, then scikit-fem's P1
    assembly. Each case runs in its own process; peak memory is the process's plus its children's
-   (the mesher's) largest resident sets, an upper bound.
+   (the mesher's) largest resident sets, an upper bound. --rounds N alternates N runs of each
+   and reports medians (the times of both move by tens of percent with the machine's load).
 5. A new bud (--bud): map_surfaces(..., "auto") on lumpy pairs of 20k and 100k faces where S2 grows
    one bud over a narrow pit of S1, so that normal mapping folds around the pit only: the share of
    the surface that folds and that auto redoes with diffusion, the time of normal mapping and of
@@ -260,8 +261,18 @@ def organ_peer(faces):
             "cpu": cpu_seconds() - cpu, "memory": peak_memory_gb()}
 
 
-def organ_table(sizes, peer_sizes):
-    """Each case in a fresh process (peak memory of its own), the peer beside it."""
+def median_run(runs):
+    """Each figure's median over the rounds (the first error, if a round failed)."""
+    failed = [run for run in runs if "error" in run]
+    if failed:
+        return failed[0]
+    return {key: float(np.median([run[key] for run in runs])) for key in runs[0]}
+
+
+def organ_table(sizes, peer_sizes, rounds=1):
+    """Each case in a fresh process (peak memory of its own), the peer beside it; with rounds > 1,
+    morphomap and the peer alternate, each figure is the median of the rounds, and the last column
+    gives the ratio's range over the rounds (both sides' times move with the machine's load)."""
     def run(kind, faces):
         command = [sys.executable, __file__, "--case", kind, str(faces)] + ([] if REPEATABLE else ["--all-cores"])
         done = subprocess.run(command, capture_output=True, text=True, check=False)
@@ -270,29 +281,41 @@ def organ_table(sizes, peer_sizes):
         return json.loads(done.stdout.strip().splitlines()[-1])
 
     print("\n4. Lumpy nested pairs (radius ~1 in ~2): end to end, and TetGen + scikit-fem assembly"
-          + ("" if REPEATABLE else " (morphomap: repeatable=False)"))
+          + ("" if REPEATABLE else " (morphomap: repeatable=False)")
+          + (f"; medians of {rounds} alternated rounds" if rounds > 1 else ""))
     print("| faces per surface | tetrahedra | mesh s | solve s | trace s | total s | CPU s | lost | folds "
           "| peak memory GB | TetGen tetrahedra | TetGen s | assembly s | peer CPU s | peer memory GB "
           "| peer / morphomap (wall, CPU) |")
     print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     totals = []
     for faces in sizes:
-        ours = run("morphomap", faces)
-        peer = run("peer", faces) if faces in peer_sizes else None
+        ours_runs, peer_runs = [], []
+        for _ in range(rounds):
+            ours_runs.append(run("morphomap", faces))
+            if faces in peer_sizes:
+                peer_runs.append(run("peer", faces))
+        ours, peer = median_run(ours_runs), median_run(peer_runs) if peer_runs else None
+        if "error" in ours:
+            print(f"| {faces:,} | {ours['error']} |", flush=True)
+            continue
         totals.append((ours["faces"], ours["cpu"]))
-        row = (f"| {ours['faces']:,} | {ours['tetrahedra']:,} | {ours['mesh']:.1f} | {ours['solve']:.2f} | "
-               f"{ours['trace']:.2f} | {ours['total']:.1f} | {ours['cpu']:.1f} | {ours['lost']} | {ours['folds']} | "
-               f"{ours['memory']:.2f} |")
+        row = (f"| {ours['faces']:,.0f} | {ours['tetrahedra']:,.0f} | {ours['mesh']:.1f} | {ours['solve']:.2f} | "
+               f"{ours['trace']:.2f} | {ours['total']:.1f} | {ours['cpu']:.1f} | {ours['lost']:.0f} | "
+               f"{ours['folds']:.0f} | {ours['memory']:.2f} |")
         if peer and "error" not in peer:
             ratio = (peer["mesh"] + peer["assembly"]) / ours["total"]
-            row += (f" {peer['tetrahedra']:,} | {peer['mesh']:.1f} | {peer['assembly']:.1f} | {peer['cpu']:.1f} | "
-                    f"{peer['memory']:.2f} | {ratio:.1f}x, {peer['cpu'] / ours['cpu']:.1f}x |")
+            row += (f" {peer['tetrahedra']:,.0f} | {peer['mesh']:.1f} | {peer['assembly']:.1f} | {peer['cpu']:.1f} | "
+                    f"{peer['memory']:.2f} | {ratio:.1f}x, {peer['cpu'] / ours['cpu']:.1f}x")
+            if rounds > 1:
+                each = [(p["mesh"] + p["assembly"]) / o["total"] for o, p in zip(ours_runs, peer_runs)]
+                row += f" (wall {min(each):.1f}-{max(each):.1f}x)"
+            row += " |"
         else:
             row += f" {peer['error'] if peer else 'not run'} | | | | | |"
         print(row, flush=True)
     if len(totals) >= 2:
         (n0, t0), (n1, t1) = totals[0], totals[-1]
-        print(f"growth exponent of the total CPU time from {n0:,} to {n1:,} faces: "
+        print(f"growth exponent of the total CPU time from {n0:,.0f} to {n1:,.0f} faces: "
               f"{np.log(t1 / t0) / np.log(n1 / n0):.2f}")
 
 
@@ -317,6 +340,8 @@ def main():
     parser.add_argument("--bud", nargs="*", type=int, metavar="FACES",
                         help="only the new-bud table (5); faces per surface (default 20000 100000)")
     parser.add_argument("--all-cores", action="store_true", help="repeatable=False: Mesh_3 on all cores")
+    parser.add_argument("--rounds", type=int, default=1, metavar="N",
+                        help="--organ: N alternated rounds of morphomap and the peer, medians (default 1)")
     parser.add_argument("--case", nargs=2, metavar=("KIND", "FACES"), help=argparse.SUPPRESS)
     args = parser.parse_args()
     global REPEATABLE
@@ -329,7 +354,7 @@ def main():
         bud_table(args.bud or [20_000, 100_000])
         return
     if args.organ:
-        organ_table([10_000, 20_000, 100_000, 200_000], {20_000, 100_000, 200_000})
+        organ_table([10_000, 20_000, 100_000, 200_000], {20_000, 100_000, 200_000}, max(1, args.rounds))
         return
     # mesh_size only caps the size: near the surfaces the mesh follows their spacing (inner sphere
     # 0.077, outer 0.31, ellipsoid 0.05), so the caps below are what refines it.
