@@ -1,6 +1,7 @@
 // Contact patches between two closed surfaces (see contact3d.hpp).
 #include "diffusion/contact3d.hpp"
 
+#include "common/mesh_adjacency.hpp"
 #include "diffusion/shell_mesh.hpp"
 
 #include <morphomap/errors.hpp>
@@ -17,42 +18,17 @@ namespace {
 
 using Vec3 = Eigen::Vector3d;
 
-// Neighbouring vertices of each vertex, as compressed rows.
-struct Adjacency {
-  std::vector<Index> start, next;
-};
-
-Adjacency adjacency(Index vertex_count, const FacesRef& faces) {
-  std::vector<std::vector<Index>> lists(static_cast<std::size_t>(vertex_count));
-  for (Index f = 0; f < faces.rows(); ++f) {
-    for (int k = 0; k < 3; ++k) {
-      const Index a = faces(f, k), b = faces(f, (k + 1) % 3);
-      lists[a].push_back(b);
-      lists[b].push_back(a);
-    }
-  }
-  Adjacency result;
-  result.start.push_back(0);
-  for (auto& list : lists) {
-    std::sort(list.begin(), list.end());
-    list.erase(std::unique(list.begin(), list.end()), list.end());
-    result.next.insert(result.next.end(), list.begin(), list.end());
-    result.start.push_back(static_cast<Index>(result.next.size()));
-  }
-  return result;
-}
-
 // Vertex normals averaged over a few rings: on an unsmoothed marching-cubes staircase the normals
 // of neighbouring vertices differ by 90 degrees, and pulling vertices back along them folds the
 // surface into itself at every step of the stairs.
-Points3 smoothed_normals(const Points3Ref& vertices, const FacesRef& faces, const Adjacency& around) {
+Points3 smoothed_normals(const Points3Ref& vertices, const FacesRef& faces, const detail::CompressedRows& around) {
   constexpr int kRounds = 2;
   Points3 normals = vertex_normals(vertices, faces);
   Points3 next(normals.rows(), 3);
   for (int round = 0; round < kRounds; ++round) {
     for (Index v = 0; v < normals.rows(); ++v) {
       Eigen::RowVector3d sum = normals.row(v);
-      for (Index k = around.start[v]; k < around.start[v + 1]; ++k) sum += normals.row(around.next[k]);
+      for (Index k = around.first[v]; k < around.first[v + 1]; ++k) sum += normals.row(around.entries[k]);
       const double norm = sum.norm();
       next.row(v) = norm > 0.0 ? Eigen::RowVector3d(sum / norm) : Eigen::RowVector3d(normals.row(v));
     }
@@ -130,11 +106,11 @@ ClearedSource clear_contact(const Points3Ref& source_vertices, const FacesRef& s
   }
 
   // Which side of the target each vertex near it, or next to such a vertex, lies on.
-  const Adjacency around = adjacency(n, source_faces);
+  const detail::CompressedRows around = detail::neighbouring_vertices(n, source_faces);
   std::vector<Index> asked;
   for (Index i = 0; i < n; ++i) {
     bool ask = near[i];
-    for (Index k = around.start[i]; k < around.start[i + 1] && !ask; ++k) ask = near[around.next[k]];
+    for (Index k = around.first[i]; k < around.first[i + 1] && !ask; ++k) ask = near[around.entries[k]];
     if (ask) asked.push_back(i);
   }
   Points3 queries(static_cast<Index>(asked.size()), 3);
@@ -157,8 +133,8 @@ ClearedSource clear_contact(const Points3Ref& source_vertices, const FacesRef& s
       const Index v = stack.back();
       stack.pop_back();
       patch.push_back(v);
-      for (Index k = around.start[v]; k < around.start[v + 1]; ++k) {
-        const Index w = around.next[k];
+      for (Index k = around.first[v]; k < around.first[v + 1]; ++k) {
+        const Index w = around.entries[k];
         if (!near[w]) {
           (inside[w] ? ring_inside : ring_outside) += 1;
         } else if (!labelled[w]) {

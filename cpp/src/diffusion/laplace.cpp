@@ -6,6 +6,7 @@
 #include <morphomap/transform.hpp>
 
 #include "common/interrupt_check.hpp"
+#include "common/mesh_adjacency.hpp"
 #include "common/numbers.hpp"
 #include "common/validation.hpp"
 #include "curves/inside.hpp"
@@ -23,6 +24,7 @@
 #include <cmath>
 #include <limits>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 namespace morphomap {
@@ -65,21 +67,14 @@ class Tracer {
         to_barycentric_(mesh.triangles.rows()),
         flow_(mesh.triangles.rows()) {
     const Index n = mesh.vertices.rows(), triangles = mesh.triangles.rows();
-    offsets_.assign(n + 1, 0);
-    for (Index t = 0; t < triangles; ++t) {
-      for (int i = 0; i < 3; ++i) ++offsets_[mesh.triangles(t, i) + 1];
-    }
-    for (Index v = 0; v < n; ++v) offsets_[v + 1] += offsets_[v];
-    incident_.resize(offsets_[n]);
-    std::vector<Index> fill(offsets_.begin(), offsets_.end() - 1);
+    detail::CompressedRows around = detail::incident_elements(n, mesh.triangles);
+    offsets_ = std::move(around.first);
+    incident_ = std::move(around.entries);
     std::vector<double> weight(n, 0.0);
     velocity_.assign(n, Vec2::Zero());
     for (Index t = 0; t < triangles; ++t) {
       Vec2 p[3];
-      for (int i = 0; i < 3; ++i) {
-        incident_[fill[mesh.triangles(t, i)]++] = t;
-        p[i] = point(mesh.triangles(t, i));
-      }
+      for (int i = 0; i < 3; ++i) p[i] = point(mesh.triangles(t, i));
       const double area2 = cross(p[1] - p[0], p[2] - p[0]);
       // -grad c = -sum_i c_i grad phi_i, grad phi_i = rot(edge opposite i) / (2 area).
       Vec2 flow = Vec2::Zero();

@@ -7,6 +7,7 @@
 
 #include "common/finite_rows.hpp"
 #include "common/interrupt_check.hpp"
+#include "common/mesh_adjacency.hpp"
 #include "common/numbers.hpp"
 #include "common/run_both.hpp"
 #include "common/validation.hpp"
@@ -207,11 +208,18 @@ class Tracer {
   // gradient at the vertex is second-order accurate. The mean stays where the fit is singular.
   void recover_by_least_squares(const Vector& c) {
     const Index n = mesh_.vertices.rows();
-    const std::vector<std::vector<Index>> ring = neighbour_rings();
+    const detail::CompressedRows ring = detail::neighbouring_vertices(n, mesh_.tetrahedra);
+    const auto ring_of = [&](Index v) {
+      return std::make_pair(ring.entries.begin() + ring.first[v], ring.entries.begin() + ring.first[v + 1]);
+    };
     tbb::parallel_for(Index(0), n, [&](Index v) {
-      std::vector<Index> patch = ring[v];
+      const auto [begin, end] = ring_of(v);
+      std::vector<Index> patch(begin, end);
       if (patch.size() < 14) {
-        for (const Index w : ring[v]) patch.insert(patch.end(), ring[w].begin(), ring[w].end());
+        for (auto w = begin; w != end; ++w) {
+          const auto [from, to] = ring_of(*w);
+          patch.insert(patch.end(), from, to);
+        }
         std::sort(patch.begin(), patch.end());
         patch.erase(std::unique(patch.begin(), patch.end()), patch.end());
         patch.erase(std::remove(patch.begin(), patch.end(), v), patch.end());
@@ -237,34 +245,6 @@ class Tracer {
       if (!x.allFinite()) return;
       velocity_[v] = -x.head<3>() / h;
     });
-  }
-
-  // The vertices that share a tetrahedron with each vertex, sorted: gathered from each vertex's
-  // tetrahedra (listed first), so that the rings are filled on all cores.
-  std::vector<std::vector<Index>> neighbour_rings() const {
-    const Index n = mesh_.vertices.rows(), tets = mesh_.tetrahedra.rows();
-    std::vector<Index> first(n + 1, 0);
-    for (Index t = 0; t < tets; ++t) {
-      for (int i = 0; i < 4; ++i) ++first[mesh_.tetrahedra(t, i) + 1];
-    }
-    for (Index v = 0; v < n; ++v) first[v + 1] += first[v];
-    std::vector<Index> incident(first[n]), next(first.begin(), first.end() - 1);
-    for (Index t = 0; t < tets; ++t) {
-      for (int i = 0; i < 4; ++i) incident[next[mesh_.tetrahedra(t, i)]++] = t;
-    }
-    std::vector<std::vector<Index>> ring(n);
-    tbb::parallel_for(Index(0), n, [&](Index v) {
-      std::vector<Index>& r = ring[v];
-      for (Index k = first[v]; k < first[v + 1]; ++k) {
-        for (int j = 0; j < 4; ++j) {
-          const Index w = mesh_.tetrahedra(incident[k], j);
-          if (w != v) r.push_back(w);
-        }
-      }
-      std::sort(r.begin(), r.end());
-      r.erase(std::unique(r.begin(), r.end()), r.end());
-    });
-    return ring;
   }
 
   // From the gradients of the barycentric coordinates, kept from the constructor: a streamline
