@@ -341,9 +341,8 @@ class Tracer {
 // streamline from any point of a facet interpolated linearly from its corners'. Tracing every
 // vertex of s1 cost time in proportion to s1's resolution, not the mesh's (50k streamlines at 100k
 // faces, from 3k corners), and was less accurate: a streamline from inside a facet starts along a
-// blend of its corners' normals, not the surface's. Interpolated, the concentric spheres' RMS
-// fell from 7.89e-3 to 6.61e-3 and a lumpy 100k pair's ends came a sixth closer to a finer
-// mesh's (bench/README.md, session 16).
+// blend of its corners' normals, not the surface's, and such exits scatter about the smooth map
+// (measured against radial truth and a finer mesh in bench/README.md, session 16).
 class FacetNodes {
  public:
   FacetNodes(const detail::ShellMesh& mesh, const Faces& facets, const std::vector<Index>& source_facets)
