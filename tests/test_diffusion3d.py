@@ -267,8 +267,8 @@ def test_exits_interpolated_from_the_mesh_corners_beat_a_streamline_per_vertex()
     rms_traced = angular_rms(inner[0], traced.ends, 4.0)
     assert rms_interpolated < 5.5e-3
     assert rms_interpolated < 0.95 * rms_traced, (rms_interpolated, rms_traced)
-    # The same mesh and field: the two differ by the traced starts' scatter only.
-    assert np.linalg.norm(interpolated.ends - traced.ends, axis=1).max() < 0.03
+    # The same mesh and field: the two differ by the traced starts' scatter only (max 8.2e-3).
+    assert np.linalg.norm(interpolated.ends - traced.ends, axis=1).max() < 0.015
 
 
 def test_a_thin_shell_meshes_to_its_surfaces_spacing_not_to_a_quarter_of_its_gap():

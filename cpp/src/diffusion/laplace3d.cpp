@@ -355,6 +355,7 @@ class FacetNodes {
         if (node < 0) {
           node = static_cast<Index>(facet_of_.size());
           facet_of_.push_back(k);
+          vertex_of_.push_back(facets(k, j));
         }
         corner_nodes_(k, j) = node;
       }
@@ -367,11 +368,10 @@ class FacetNodes {
     const Index count = static_cast<Index>(facet_of_.size());
     Points3 exits(count, 3);
     tbb::parallel_for(Index(0), count, [&](Index n) {
-      const Index k = facet_of_[static_cast<std::size_t>(n)];
-      Index corner = 0;
-      while (corner_nodes_(k, corner) != n) ++corner;
-      const Vec3 start = vertices_.row(facets_(k, corner)).transpose();
-      exits.row(n) = tracer.trace(source_facets_[static_cast<std::size_t>(k)] / 4, start, nullptr).transpose();
+      const auto node = static_cast<std::size_t>(n);
+      const Vec3 start = vertices_.row(vertex_of_[node]).transpose();
+      exits.row(n) =
+          tracer.trace(source_facets_[static_cast<std::size_t>(facet_of_[node])] / 4, start, nullptr).transpose();
     });
     return exits;
   }
@@ -393,7 +393,8 @@ class FacetNodes {
   const Faces& facets_;
   const std::vector<Index>& source_facets_;
   const Points3& vertices_;
-  std::vector<Index> facet_of_;  // each corner node: the first facet it is a corner of
+  std::vector<Index> facet_of_;   // each corner node: the first facet it is a corner of
+  std::vector<Index> vertex_of_;  // and its mesh vertex
   Eigen::Matrix<Index, Eigen::Dynamic, 3, Eigen::RowMajor> corner_nodes_;
 };
 
@@ -644,7 +645,7 @@ ShellDiffusionSolution detail::solve_diffusion_3d(const ShellPair& pair, const S
   // corners of its facet (FacetNodes); where one of those was lost, and where the surfaces cross
   // (the exits bend sharply near the crossing curves), for a part of s1 (local) and when the
   // streamlines are kept, each vertex is traced itself.
-  std::vector<char> traced(static_cast<std::size_t>(ns), 0);
+  std::vector<char> interpolated(static_cast<std::size_t>(ns), 0);
   if (!crossing && local == nullptr && !options.keep_streamlines) {
     const FacetNodes nodes(mesh, facets, source_facets);
     const Points3 node_exits = nodes.trace(tracer);
@@ -652,12 +653,12 @@ ShellDiffusionSolution detail::solve_diffusion_3d(const ShellPair& pair, const S
       const Vec3 exit = nodes.interpolate(node_exits, starts.faces[i], starts.points.row(i).transpose());
       if (std::isnan(exit.x())) return;
       exits.row(i) = exit.transpose();
-      traced[static_cast<std::size_t>(i)] = 1;
+      interpolated[static_cast<std::size_t>(i)] = 1;
     });
   }
   std::vector<std::vector<Vec3>> paths(options.keep_streamlines ? ns : 0);
   tbb::parallel_for(Index(0), ns, [&](Index i) {
-    if (traced[static_cast<std::size_t>(i)]) return;
+    if (interpolated[static_cast<std::size_t>(i)]) return;
     if (local != nullptr && !local->traced[static_cast<std::size_t>(i)]) {
       exits.row(i).setConstant(kNaN);
       return;
