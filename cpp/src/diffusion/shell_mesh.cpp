@@ -231,12 +231,14 @@ void seed_patch(Complex& c3t3, const Domain& domain, const SurfaceMesh& surface,
 }
 
 // Delaunay refinement of the complex to the criteria (no perturbation), then optionally exudation
-// of slivers until no dihedral angle is below 30 degrees, without a time limit. By default Mesh_3
+// of slivers until no dihedral angle is below 20 degrees, without a time limit. By default Mesh_3
 // stops exudation after as many seconds as the refinement took, so how many slivers it removed
 // depended on the machine's load, and the same input gave other meshes and ends from call to
 // call. Without a bound it removes every sliver it can, at twice the CPU time of the whole
-// meshing for no better ends; at 30 degrees the ends are as good as before (bench/README.md).
-constexpr double kSliverBound = 30.0;
+// meshing for no better ends. Since exits are interpolated from the mesh's corners (laplace3d.cpp),
+// 20 degrees gives ends as good as 30 did before, in about a third of the exudation time
+// (bench/README.md, organ scale, sessions 16 and 17).
+constexpr double kSliverBound = 20.0;
 
 template <class Complex, class MeshCriteria>
 void refine(Complex& c3t3, const Domain& domain, const MeshCriteria& criteria, bool exude) {
