@@ -181,7 +181,9 @@ def test_crossing_surfaces_reverse_is_inverse(crossing):
     error = np.linalg.norm(back - s1[0], axis=1)
     mean_displacement = np.linalg.norm(forward.ends - s1[0], axis=1).mean()
     assert mean_displacement > 0.2
-    assert np.sqrt(np.mean(error**2)) < 0.005 and error.max() < 0.03
+    # Exits interpolated from the mesh's corners: RMS 2.26e-3, max 9.2e-3 (one streamline per
+    # vertex gave 2.51e-3 and 1.41e-2; bench/README.md, session 17).
+    assert np.sqrt(np.mean(error**2)) < 0.005 and error.max() < 0.012
 
 
 def test_crossing_surfaces_bad_input():

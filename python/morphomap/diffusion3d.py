@@ -23,11 +23,12 @@ class ShellDiffusionSolution:
         c at the vertices: P1 finite elements with c = 1 on S1 and c = 0 on S2.
     ends : (N, 3) float
         For each vertex of S1, where its streamline of -grad c meets S2 (NaN if it does not); for a
-        vertex that touches S2, its closest point there. Between nested surfaces (without
-        ``streamlines=True``) the streamlines are traced from the corners of the mesh's facets on
-        S1 and each vertex's end is interpolated linearly over its facet, then put onto S2: faster
-        for a finely triangulated S1, and closer to the exact map than a streamline per vertex
-        (bench/README.md, session 16). Elsewhere each vertex is traced.
+        vertex that touches S2, its closest point there. Unless ``streamlines=True``, the
+        streamlines are traced from the corners of the mesh's facets on S1 and each vertex's end
+        is interpolated linearly over its facet, then put onto S2: faster for a finely
+        triangulated S1, and closer to the exact map than a streamline per vertex (bench/README.md,
+        sessions 16 and 17). A vertex whose facet has a corner whose streamline was lost, and
+        every vertex with ``streamlines=True``, is traced itself.
     touching : (N,) bool
         The vertices of S1 that touch S2 (within 1% of the finer mean edge): cut out of the region.
     streamlines : list of (K, 3) float

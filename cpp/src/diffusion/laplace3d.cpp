@@ -362,13 +362,19 @@ class FacetNodes {
     }
   }
 
-  // Each corner's exit (NaN where its streamline was lost), traced from the first facet it is a
-  // corner of.
-  Points3 trace(const Tracer& tracer) const {
+  // The exit of each corner of the wanted facets (NaN where its streamline was lost, and at the
+  // other corners), traced from the first facet it is a corner of.
+  Points3 trace(const Tracer& tracer, const std::vector<char>& wanted_facets) const {
     const Index count = static_cast<Index>(facet_of_.size());
-    Points3 exits(count, 3);
+    std::vector<char> wanted(static_cast<std::size_t>(count), 0);
+    for (Index k = 0; k < facets_.rows(); ++k) {
+      if (!wanted_facets[static_cast<std::size_t>(k)]) continue;
+      for (int j = 0; j < 3; ++j) wanted[static_cast<std::size_t>(corner_nodes_(k, j))] = 1;
+    }
+    Points3 exits = Points3::Constant(count, 3, kNaN);
     tbb::parallel_for(Index(0), count, [&](Index n) {
       const auto node = static_cast<std::size_t>(n);
+      if (!wanted[node]) return;
       const Vec3 start = vertices_.row(vertex_of_[node]).transpose();
       exits.row(n) =
           tracer.trace(source_facets_[static_cast<std::size_t>(facet_of_[node])] / 4, start, nullptr).transpose();
@@ -641,15 +647,21 @@ ShellDiffusionSolution detail::solve_diffusion_3d(const ShellPair& pair, const S
   const Tracer tracer(mesh, solution.potential, kind);
   const Index ns = source_vertices.rows();
   Points3 exits(ns, 3);
-  // Between nested surfaces, each vertex's exit is interpolated from the streamlines of the
-  // corners of its facet (FacetNodes); where one of those was lost, and where the surfaces cross
-  // (the exits bend sharply near the crossing curves), for a part of s1 (local) and when the
-  // streamlines are kept, each vertex is traced itself.
+  // Each vertex's exit is interpolated from the streamlines of the corners of its facet
+  // (FacetNodes; for a part of s1, only the facets of the vertices it traces); where one of those
+  // was lost, and when the streamlines are kept, the vertex is traced itself.
   std::vector<char> interpolated(static_cast<std::size_t>(ns), 0);
-  if (!crossing && local == nullptr && !options.keep_streamlines) {
+  if (!options.keep_streamlines) {
     const FacetNodes nodes(mesh, facets, source_facets);
-    const Points3 node_exits = nodes.trace(tracer);
+    std::vector<char> wanted(source_facets.size(), local == nullptr ? 1 : 0);
+    if (local != nullptr) {
+      for (Index i = 0; i < ns; ++i) {
+        if (local->traced[static_cast<std::size_t>(i)]) wanted[static_cast<std::size_t>(starts.faces[i])] = 1;
+      }
+    }
+    const Points3 node_exits = nodes.trace(tracer, wanted);
     tbb::parallel_for(Index(0), ns, [&](Index i) {
+      if (!wanted[static_cast<std::size_t>(starts.faces[i])]) return;
       const Vec3 exit = nodes.interpolate(node_exits, starts.faces[i], starts.points.row(i).transpose());
       if (std::isnan(exit.x())) return;
       exits.row(i) = exit.transpose();
