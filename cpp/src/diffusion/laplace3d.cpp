@@ -647,21 +647,21 @@ ShellDiffusionSolution detail::solve_diffusion_3d(const ShellPair& pair, const S
   const Tracer tracer(mesh, solution.potential, kind);
   const Index ns = source_vertices.rows();
   Points3 exits(ns, 3);
-  // Each vertex's exit is interpolated from the streamlines of the corners of its facet
-  // (FacetNodes; for a part of s1, only the facets of the vertices it traces); where one of those
-  // was lost, and when the streamlines are kept, the vertex is traced itself.
+  // The vertices that get an exit: all of them, or those a local diffusion traces (else NaN).
+  const auto wanted = [&](Index i) { return local == nullptr || local->traced[static_cast<std::size_t>(i)] != 0; };
+  // Each wanted vertex's exit is interpolated from the streamlines of the corners of its facet
+  // (FacetNodes: only the facets that hold such a vertex); where one of those was lost, and when
+  // the streamlines are kept, the vertex is traced itself.
   std::vector<char> interpolated(static_cast<std::size_t>(ns), 0);
   if (!options.keep_streamlines) {
     const FacetNodes nodes(mesh, facets, source_facets);
-    std::vector<char> wanted(source_facets.size(), local == nullptr ? 1 : 0);
-    if (local != nullptr) {
-      for (Index i = 0; i < ns; ++i) {
-        if (local->traced[static_cast<std::size_t>(i)]) wanted[static_cast<std::size_t>(starts.faces[i])] = 1;
-      }
+    std::vector<char> wanted_facets(source_facets.size(), 0);
+    for (Index i = 0; i < ns; ++i) {
+      if (wanted(i)) wanted_facets[static_cast<std::size_t>(starts.faces[i])] = 1;
     }
-    const Points3 node_exits = nodes.trace(tracer, wanted);
+    const Points3 node_exits = nodes.trace(tracer, wanted_facets);
     tbb::parallel_for(Index(0), ns, [&](Index i) {
-      if (!wanted[static_cast<std::size_t>(starts.faces[i])]) return;
+      if (!wanted(i)) return;
       const Vec3 exit = nodes.interpolate(node_exits, starts.faces[i], starts.points.row(i).transpose());
       if (std::isnan(exit.x())) return;
       exits.row(i) = exit.transpose();
@@ -671,7 +671,7 @@ ShellDiffusionSolution detail::solve_diffusion_3d(const ShellPair& pair, const S
   std::vector<std::vector<Vec3>> paths(options.keep_streamlines ? ns : 0);
   tbb::parallel_for(Index(0), ns, [&](Index i) {
     if (interpolated[static_cast<std::size_t>(i)]) return;
-    if (local != nullptr && !local->traced[static_cast<std::size_t>(i)]) {
+    if (!wanted(i)) {
       exits.row(i).setConstant(kNaN);
       return;
     }
