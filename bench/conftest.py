@@ -1,4 +1,4 @@
-"""Shared, session-wide inputs for the benchmarks: cases, built indexes and morphomap's answers.
+"""Inputs shared by the benchmarks, built once per pytest run: cases, built indexes and morphomap's answers.
 
 Everything here is made once and outside the timed part; see curve_peers.py for the tools.
 """

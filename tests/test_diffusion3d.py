@@ -182,7 +182,8 @@ def test_crossing_surfaces_reverse_is_inverse(crossing):
     mean_displacement = np.linalg.norm(forward.ends - s1[0], axis=1).mean()
     assert mean_displacement > 0.2
     # Exits interpolated from the mesh's corners: RMS 2.26e-3, max 9.2e-3 (one streamline per
-    # vertex gave 2.51e-3 and 1.41e-2; bench/README.md, session 17).
+    # vertex gave 2.51e-3 and 1.41e-2; bench/README.md, "Exits interpolated from the mesh's source
+    # corners").
     assert np.sqrt(np.mean(error**2)) < 0.005 and error.max() < 0.012
 
 
@@ -250,7 +251,8 @@ def test_a_coarse_inner_sphere_is_as_accurate_by_default():
 def test_finely_triangulated_spheres_mesh_to_their_shape_not_to_their_triangles():
     # 10242 vertices each (mean edges 0.038 and 0.15): the mesh near each surface stops at 1.5% of
     # its diagonal (0.052 and 0.21). At 1% it had 408k tetrahedra and an RMS end error of 4.9e-3;
-    # now 228k and 5.9e-3, below the 2562-vertex default row's 7.9e-3 (bench/README.md, session 14).
+    # now 228k and 5.9e-3, below the 2562-vertex default row's 7.9e-3 (bench/README.md, "The finest
+    # element size").
     solution, rms = radial_default(sphere(1.0, 5), 4.0)
     assert len(solution.tetrahedra) < 300_000, len(solution.tetrahedra)
     assert rms < 7.0e-3
@@ -259,7 +261,8 @@ def test_finely_triangulated_spheres_mesh_to_their_shape_not_to_their_triangles(
 def test_exits_interpolated_from_the_mesh_corners_beat_a_streamline_per_vertex():
     # 10242 vertices on S1, about 3.3k corners on the mesh's source boundary: by default each
     # vertex's exit is interpolated from the corners' streamlines (measured RMS 5.02e-3); with
-    # streamlines=True each vertex is traced itself (5.90e-3, bench/README.md, session 16).
+    # streamlines=True each vertex is traced itself (5.90e-3, bench/README.md, "Exits interpolated
+    # from the mesh's source corners").
     inner = sphere(1.0, 5)
     outer = (inner[0] * 4.0, inner[1])
     interpolated = mm.solve_diffusion_3d(inner, outer)

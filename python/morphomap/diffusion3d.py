@@ -27,8 +27,8 @@ class ShellDiffusionSolution:
         streamlines are traced from the corners of the mesh's facets on S1 and each vertex's end
         is interpolated linearly over its facet, then put onto S2: faster for a finely
         triangulated S1, and closer to the exact map than a streamline per vertex (bench/README.md,
-        sessions 16 and 17). A vertex whose facet has a corner whose streamline was lost, and
-        every vertex with ``streamlines=True``, is traced itself.
+        "Exits interpolated from the mesh's source corners"). A vertex whose facet has a corner
+        whose streamline was lost, and every vertex with ``streamlines=True``, is traced itself.
     touching : (N,) bool
         The vertices of S1 that touch S2 (within 1% of the finer mean edge): cut out of the region.
     streamlines : list of (K, 3) float
@@ -70,7 +70,7 @@ def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False, progress=No
         Largest tetrahedron size. Default: a quarter of the mean gap (the region's volume over the
         mean area of the surfaces); in a thin shell, where that is finer than half the surfaces'
         spacing (mean edge, or 1.5% of the diagonal if larger), half that spacing but at most half
-        the gap (frames a voxel apart: 8x fewer tetrahedra, see bench/README.md). Near each
+        the gap (frames a voxel apart: 8x fewer tetrahedra, bench/README.md, "Thin shells"). Near each
         surface the mesh follows its mean edge length (or ``mesh_size`` if smaller), but no finer
         than 1.5% of the surface's bounding diagonal (where the surface curves more tightly, the
         boundary facets still follow it to a fifth of that size), and grows by a tenth of the

@@ -1,13 +1,14 @@
 #pragma once
 // CGAL's Mesh_3 (5.5) can crash on valid input: on frames contoured from masks its refinement
-// segfaults in the triangulation's insert_in_hole (fuzz seeds 5002 and 5022, among others; the
-// same pair meshes at other element sizes). A crash there must not take the caller's process down,
-// so the mesh is made in a forked child and sent back through a pipe; a child that dies becomes a
-// GeometryError, and the caller may try again with other settings. The child runs the mesher only
-// (no Python, no Embree), allocating through glibc's malloc, which its fork handlers leave usable
-// however many threads the parent has. TBB's worker threads do not survive a fork: a child that
-// is to run TBB work (the parallel mesher) gets its own only if this process's were stopped
-// before the fork; otherwise its TBB work runs on its one thread.
+// segfaults in the triangulation's insert_in_hole (pairs of the 3D fuzz suite, bench/README.md,
+// "Contact patches cut out"; the same pair meshes at other element sizes). A crash there must not
+// take the caller's process down, so the mesh is made in a forked child and sent back through a
+// pipe; a child that dies becomes a GeometryError, and the caller may try again with other
+// settings. The child runs the mesher only (no Python, no Embree), allocating through glibc's
+// malloc, which its fork handlers leave usable however many threads the parent has. TBB's worker
+// threads do not survive a fork: a child that is to run TBB work (the parallel mesher) gets its own
+// only if this process's were stopped before the fork; otherwise its TBB work runs on its one
+// thread.
 #include "diffusion/shell_mesh.hpp"
 
 #include <morphomap/errors.hpp>

@@ -70,13 +70,13 @@ std::vector<std::array<double, 3>> points_of(const SurfaceMesh& surface) {
 // The distance to the nearest of some points (a surface's vertices), interpolated trilinearly
 // between the corners of a grid, each corner searched once, on first use. Mesh_3 asks for the size
 // millions of times (2.3 million searches at 100k faces were 27% of the meshing's CPU time,
-// bench/README.md); the grid needs one search per corner near the region. Each corner's value
+// bench/README.md, "Sizing grid"); the grid needs one search per corner near the region. Each corner's value
 // depends on its position alone (whichever thread fills it first), so the mesh stays repeatable.
 // The distance is 1-Lipschitz: interpolated, it errs by less than the spacing times sqrt(3), and
 // the size by the grading times that (a third of the finest size at the spacing Sizing uses).
-// Outside the grid: the exact search. (Session 10 kept the search exact within two spacings of the
-// surface, because one real frame's field then kept a fold; the fold repair now removes it, and
-// interpolating there too saves about a tenth of the meshing time at 100k faces: bench/README.md.)
+// Outside the grid: the exact search. The grid reaches up to the surfaces: an exact zone there
+// would cost about a tenth more meshing time at 100k faces, and the fold that one real frame's
+// field kept without it is removed by the fold repair (bench/README.md, "Sizing grid").
 class GridDistance {
  public:
   GridDistance(std::vector<std::array<double, 3>> points, const CGAL::Bbox_3& box, double spacing)
@@ -190,7 +190,7 @@ class Sizing {
     return std::min(criteria_.coarsening, 1.0 + criteria_.focus_grading * beyond / size);
   }
 
-  // The grids' spacing, in sizes at their surface (bench/README.md, session 10: at 3 and 4 the
+  // The grids' spacing, in sizes at their surface (bench/README.md, "Sizing grid": at 3 and 4 the
   // concentric spheres' RMS grew by 4-7%; at 1 the corners cost as much as the searches saved).
   static constexpr double kGridFraction = 2.0;
   std::shared_ptr<const GridDistance> source_, target_, focus_;
@@ -237,7 +237,7 @@ void seed_patch(Complex& c3t3, const Domain& domain, const SurfaceMesh& surface,
 // call. Without a bound it removes every sliver it can, at twice the CPU time of the whole
 // meshing for no better ends. Since exits are interpolated from the mesh's corners (laplace3d.cpp),
 // 20 degrees gives ends as good as 30 did before, in about a third of the exudation time
-// (bench/README.md, organ scale, sessions 16 and 17).
+// (bench/README.md, "Sliver bound").
 constexpr double kSliverBound = 20.0;
 
 template <class Complex, class MeshCriteria>

@@ -3,19 +3,19 @@
 // The streamlines of the continuous flow never cross, so the exact diffusion map keeps every
 // triangle's orientation; the discrete one carries errors of the order of the tetrahedral mesh's
 // distance to the surfaces, and a sliver of S1 narrower than that (marching cubes makes them) can
-// come out flipped (fuzz seed 732004074: one sliver 0.02 wide against the mesh's distance to the
-// surfaces of 0.05). A corner of a folded triangle is moved into the kernel of its image fan: the
-// part of S2's tangent plane from which every triangle around it is seen with its orientation on
-// S1 (the intersection of one half-plane per triangle), near the kernel's point closest to where
-// it was; then onto S2. Where triangles stay folded the region grows by a ring and the step
-// repeats, a few times at most; a round is kept only when it leaves fewer folds, and what is left
-// stays folded and is counted by quality().
+// come out flipped (one 0.02 wide against the mesh's distance to the surfaces of 0.05; the fuzz
+// frames that did so are pinned in tests/test_real_frames.py). A corner of a folded triangle is
+// moved into the kernel of its image fan: the part of S2's tangent plane from which every triangle
+// around it is seen with its orientation on S1 (the intersection of one half-plane per triangle),
+// near the kernel's point closest to where it was; then onto S2. Where triangles stay folded the
+// region grows by a ring and the step repeats, a few times at most; a round is kept only when it
+// leaves fewer folds, and what is left stays folded and is counted by quality().
 //
 // Where an image fan straddles a crease of a voxel-made S2 no single tangent plane may hold a
-// kernel (fuzz seed 827098517: a triangle's image lay across a right-angled edge of S2, nearly
-// perpendicular to the face under it). Before the kernel rounds and within each, the corners of
-// the folded triangles therefore also try the umbrella step, towards the mean of their
-// neighbours' ends, judged by the fold test itself (descend below).
+// kernel (a triangle's image may lie across a right-angled edge of S2, nearly perpendicular to the
+// face under it). Before the kernel rounds and within each, the corners of the folded triangles
+// therefore also try the umbrella step, towards the mean of their neighbours' ends, judged by the
+// fold test itself (descend below).
 #include "quality/folds.hpp"
 
 #include "surfaces/surface_util.hpp"
