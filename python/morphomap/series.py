@@ -36,8 +36,11 @@ class Series:
     fields : list of DisplacementField
         One per consecutive pair: ``fields[k]`` maps frame k onto frame k + 1.
     trajectories : (T, M, d) float
-        The material points followed through the frames (``field.at`` carries each from frame k
-        to frame k + 1): first the points of frame 0 (its curve points or surface vertices), then
+        The material points followed through the frames, each lying on every frame it is alive
+        on (:mod:`morphomap.carry`: in 2D a point keeps its place along the curve between the
+        neighbouring vectors of ``fields[k]``, placed by arc length on frame k and among their
+        ends on frame k + 1; in 3D the vectors interpolated in the start triangles, then the
+        closest point of frame k + 1): first the points of frame 0 (its curve points or surface vertices), then
         the points born later where the followed points spread apart (see ``reseed`` in
         :func:`map_series`), in the order they were born. A row is NaN before the point's birth and
         from the step where it is lost (its field has no vector there).
@@ -218,7 +221,11 @@ def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **op
     Parameters
     ----------
     frames : sequence of at least 2 curves ``(N, 2)`` or surfaces (``trimesh.Trimesh`` or
-        ``(vertices, faces)``), all of one kind.
+        ``(vertices, faces)``), all of one kind. Curves as labs trace them (repeated points,
+        one-pixel spurs and necks, a first point across the closing segment) are made simple
+        once each, up front, by :func:`morphomap.make_simple`, with a ``UserWarning`` naming
+        the frame and what changed; :attr:`Series.frames` holds the repaired curves. A curve
+        it cannot repair is passed on as given (its pair's error names it).
     method : the mapping algorithm for every pair (``"auto"`` by default).
     dt : float
         The time between two frames (for the normal speeds).
@@ -245,11 +252,21 @@ def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **op
     Series
         With the fields, trajectories, growth maps (``stretch``, ``accumulated_stretch``,
         ``normal_speed``, ``accumulated_normal_speed``) and the quality per step.
+        ``fields[k]`` is ``map_curves(frames[k], frames[k + 1], method, **options)`` (or
+        ``map_surfaces``), the field of the frame's own points; the followed points are carried
+        by it onto frame k + 1 (see :attr:`Series.trajectories`).
+
+    Raises
+    ------
+    ValueError, GeometryError
+        A frame or pair that cannot be mapped, named: ``"frames[k] -> frames[k + 1]: ..."``
     """
+    from ._core import GeometryError
     from ._validate import as_length
+    from .carry import IndexedCurve, carry_curve, carry_surface
     from .mapping import PreparedCurve, map_curves
     from .quality import quality
-    from .surfaces import PreparedSurface, as_surface, map_surfaces
+    from .surfaces import PreparedSurface, SurfaceIndex, as_surface, map_surfaces
 
     frames = list(frames)
     if len(frames) < 2:
@@ -267,6 +284,8 @@ def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **op
 
         frames = [trimesh.Trimesh(*as_surface(f, f"frames[{k}]"), process=False) for k, f in enumerate(frames)]
     closed = bool(options.get("closed", True)) if curves[0] else True
+    if curves[0]:
+        frames = _simple_frames(frames, closed)
     boundary = _CurveBoundary(frames, closed) if curves[0] else _SurfaceBoundary(frames)
     positions = [boundary.first.copy()]  # per frame: every point born so far
     born = np.zeros(len(boundary.first), dtype=np.int64)
@@ -280,6 +299,7 @@ def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **op
     prepare = functools.partial(PreparedCurve, closed=closed) if curves[0] else PreparedSurface
     roles = ("c1", "c2") if curves[0] else ("s1", "s2")
     prepared = None
+    carried = None  # frame k, indexed for carrying the followed points off it
     for k in progress_over(range(len(frames) - 1), len(frames) - 1, progress, "map_series", "pair"):
         start = time.perf_counter()
         try:
@@ -287,8 +307,8 @@ def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **op
             b = prepared = prepare(frames[k + 1], roles[1])
             field = (map_curves(a, b, method, **options) if curves[0]
                      else map_surfaces(a, b, method, progress=False, **options))
-        except ValueError as error:
-            raise ValueError(f"frames[{k}] -> frames[{k + 1}]: {error}") from None
+        except (ValueError, GeometryError) as error:
+            raise type(error)(f"frames[{k}] -> frames[{k + 1}]: {error}") from None
         q = quality(field, a, b, **({"closed": closed} if curves[0] else {}))
         seconds = time.perf_counter() - start
         names, counts = np.unique(field.method, return_counts=True)
@@ -298,8 +318,14 @@ def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **op
         now = positions[k]
         alive = np.isfinite(now).all(axis=1)
         moved = np.full_like(now, np.nan)
-        if alive.any():
-            moved[alive] = now[alive] + field.at(now[alive])
+        if curves[0]:
+            carried = carried if carried is not None else IndexedCurve(frames[k], closed)
+            target = IndexedCurve(frames[k + 1], closed)
+            moved[alive] = carry_curve(field, now[alive], carried, target)
+            carried = target
+        elif alive.any():
+            target = SurfaceIndex(frames[k + 1].vertices, frames[k + 1].faces)
+            moved[alive] = carry_surface(field, now[alive], target)[0]
         # Growth over the step, on the pieces and points of frame k.
         ratio = boundary.measure(cells[k], moved) / boundary.measure(cells[k], now)
         stretches.append(ratio)
@@ -327,6 +353,27 @@ def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **op
         speed_table[k, : len(v)], mean_table[k, : len(m)] = v, m
     return Series(frames, fields, trajectories, table, born=born, cells=cells, stretches=stretches,
                   accumulated=accumulated, normal_speed=speed_table, accumulated_normal_speed=mean_table, dt=dt)
+
+
+def _simple_frames(frames, closed: bool) -> list:
+    """The curves made simple once each (:func:`morphomap.make_simple`), warning per frame repaired.
+    A curve it refuses (one that crosses itself, non-finite points) is kept as given: its pair's
+    mapping reports it, named with the pair."""
+    import warnings
+
+    from .simple import make_simple
+
+    simple = []
+    for k, frame in enumerate(frames):
+        try:
+            points, changes = make_simple(frame, closed=closed)
+        except (ValueError, TypeError):
+            simple.append(frame)
+            continue
+        if changes:
+            warnings.warn(f"frames[{k}]: {changes}", UserWarning, stacklevel=3)
+        simple.append(points)
+    return simple
 
 
 class _CurveBoundary:
