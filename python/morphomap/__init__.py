@@ -39,6 +39,7 @@ from .plot import plot_field, plot_field_3d
 from .quality import CurveQuality, SurfaceQuality, quality
 from .batch import Job, map_batch
 from .series import Series, map_series
+from .simple import make_simple
 from .queries import CurveHits, CurveIndex, closest_points, line_intersections
 from .surfaces import PreparedSurface, SurfaceHits, SurfaceIndex, map_surfaces, surface_normals
 from .transform import Similarity, align_curves, overlap_area
@@ -82,6 +83,7 @@ __all__ = [
     "is_self_intersecting",
     "line_intersections",
     "load_example",
+    "make_simple",
     "map_batch",
     "map_curves",
     "map_series",

@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from . import _core
 from ._validate import as_choice, as_flag, as_integer, as_point, as_points, as_real
 from .field import DisplacementField
+from .simple import map_repaired, repaired_curves, simple_curve
 
 #: What ``method`` takes: the core's registry (``kMapMethods``), then ``"best"``, which is Python's.
 CURVE_METHODS = tuple(_core.MAP_METHODS) + ("best",)
@@ -62,9 +65,19 @@ class PreparedCurve:
         # A copy, read-only: the core holds its own, and a caller editing the array afterwards must
         # not leave the two sides of a mixed call on different curves. Finiteness is the core's rule.
         self.points = np.array(as_points(points, str(name), allow_nan=True), copy=True)
-        self.points.flags.writeable = False
         self.closed = as_flag(closed, "closed")
-        self._prepared = _core.PreparedCurve(self.points, self.closed, str(name))
+        try:
+            self._prepared = _core.PreparedCurve(self.points, self.closed, str(name))
+        except ValueError as error:
+            # As map_curves: a traced contour is kept as make_simple repairs it, with a warning.
+            points, changes = simple_curve(self.points, self.closed, str(name))
+            if not changes:
+                raise error from None
+            warnings.warn(f"{name}: prepared as morphomap.make_simple makes it simple (pass its result to "
+                          f"silence this): {changes}", UserWarning, stacklevel=2)
+            self.points = points
+            self._prepared = _core.PreparedCurve(self.points, self.closed, str(name))
+        self.points.flags.writeable = False
 
 
 def as_curve(value, name: str, *, allow_nan: bool = False) -> np.ndarray:
@@ -173,7 +186,10 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
 
     Both curves must be simple: one loop each, not meeting itself (``ValueError`` naming the
     curve otherwise, with the count; :func:`split_components` separates the loops of several
-    objects joined into one array).
+    objects joined into one array). A contour as labs trace it — repeated points, one-pixel spurs
+    and necks, a first point across the closing segment — is mapped as :func:`make_simple`
+    repairs it, with one ``UserWarning`` saying what was changed; start points the repair moved
+    are put back on ``c1``'s own points, removed ones have no vector.
 
     Returns
     -------
@@ -190,6 +206,7 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
         # Checked here, as a candidate that refuses an option would only drop out of the choice.
         _core.validate_options(closed, **_core_options(n, anchor, density_threshold, contact_tolerance, mesh_size,
                                                         mesh_fraction, stretch_weight))
+        (c1, c2), _ = repaired_curves(c1, c2, closed, stacklevel=2)
         return map_best(as_curve(c1, "c1"), as_curve(c2, "c2"), closed=closed, n=n, split=split, anchor=anchor,
                         density_threshold=density_threshold, contact_tolerance=contact_tolerance,
                         mesh_size=mesh_size, mesh_fraction=mesh_fraction, stretch_weight=stretch_weight,
@@ -203,6 +220,13 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
         core, curves = _core.map_prepared_curves, (c1._prepared, c2._prepared)
     else:
         core, curves = _core.map_curves, (source, as_curve(c2, "c2", allow_nan=True))
-    record = core(*curves, method, closed, reverse=as_flag(reverse, "reverse"),
-                  transform=as_flag(transform, "transform"), split=as_flag(split, "split"), **options)
+    flags = dict(reverse=as_flag(reverse, "reverse"), transform=as_flag(transform, "transform"),
+                 split=as_flag(split, "split"), **options)
+    try:
+        record = core(*curves, method, closed, **flags)
+    except ValueError as error:
+        # Not simple: a contour as traced (necks, spurs, repeats) is mapped as make_simple repairs
+        # it, with a warning; anything else raises. Simple curves pay nothing for this.
+        return map_repaired(error, c1, c2, closed, lambda a, b: DisplacementField._from_core(
+            _core.map_curves(a, b, method, closed, **flags), source=a, closed=closed))
     return DisplacementField._from_core(record, source=source, closed=closed)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 
 import numpy as np
 
@@ -57,9 +58,14 @@ def _read_and_map(args, parser):
             field = morphomap.map_surfaces(c1, c2, args.method, reverse=args.reverse, mesh_size=args.mesh_size)
             q = morphomap.quality(field, c1, c2)
         else:
-            field = morphomap.map_curves(c1, c2, args.method, closed=args.closed, n=args.n, reverse=args.reverse,
-                                         transform=args.transform, split=args.split,
-                                         contact_tolerance=args.contact_tolerance, mesh_size=args.mesh_size)
+            # A traced contour that make_simple repairs is mapped repaired: say so on stderr.
+            with warnings.catch_warnings(record=True) as told:
+                warnings.simplefilter("always", UserWarning)
+                field = morphomap.map_curves(c1, c2, args.method, closed=args.closed, n=args.n,
+                                             reverse=args.reverse, transform=args.transform, split=args.split,
+                                             contact_tolerance=args.contact_tolerance, mesh_size=args.mesh_size)
+            for warning in told:
+                print(f"morphomap: warning: {warning.message}", file=sys.stderr)
             q = morphomap.quality(field, c1, c2, closed=args.closed)
     except (ValueError, TypeError, morphomap.InvalidInput, morphomap.GeometryError) as error:
         parser.error(f"cannot map {args.c1} onto {args.c2} with --method {args.method}: {error}")
