@@ -1,35 +1,29 @@
 // Diffusion mapping in 3D: P1 finite elements for the Laplace equation on the tetrahedral mesh of
 // the region between two closed surfaces (a shell, or the pieces of the symmetric difference of
-// crossing surfaces), and streamlines of the recovered gradient.
+// crossing surfaces), and streamlines of the recovered gradient. Here the checks and the solve;
+// the mesh in shell_sizing.hpp, the streamlines in shell_tracer.hpp.
 #include <morphomap/errors.hpp>
 #include <morphomap/laplace3d.hpp>
 #include <morphomap/surface_queries.hpp>
 
 #include "common/finite_rows.hpp"
-#include "common/interrupt_check.hpp"
-#include "common/mesh_adjacency.hpp"
 #include "common/numbers.hpp"
 #include "common/run_both.hpp"
 #include "common/validation.hpp"
-#include "diffusion/contact3d.hpp"
 #include "diffusion/dirichlet.hpp"
-#include "diffusion/mesh_in_child.hpp"
 #include "diffusion/shell_diffusion.hpp"
 #include "diffusion/shell_mesh.hpp"
-#include "surfaces/surface_util.hpp"
+#include "diffusion/shell_sizing.hpp"
+#include "diffusion/shell_tracer.hpp"
 
-#include <tbb/parallel_for.h>
 #include <Eigen/Dense>
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
-#include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <limits>
 #include <memory>
-#include <string>
 #include <vector>
 
 namespace morphomap {
@@ -39,49 +33,10 @@ using detail::kNaN;
 namespace {
 
 using Vec3 = Eigen::Vector3d;
-using Vec4 = Eigen::Vector4d;
-constexpr double kSourceFraction = 0.02;
-// The finest element size near a surface, as a fraction of its bounding diagonal (below).
-constexpr double kFinestFraction = 0.015;
-constexpr int kMeshAttempts = 3;
-// Away from the part a local diffusion traces, the sizes grow by this times the distance beyond
-// its focus, up to kCoarsening times (bench/README.md, "A new bud, locally").
-constexpr double kFocusGrading = 0.25;
-constexpr double kCoarsening = 4.0;
-constexpr const char* kMeshing = "meshing the region between the surfaces";
-constexpr double kFacetDistanceNested = 0.2;
-constexpr double kFacetDistanceCrossing = 0.05;
-// Surfaces closer than this fraction of their finer mean edge touch (as 2D's contact tolerance).
-constexpr double kTouchFraction = 0.01;
-// Where they come closer than this fraction of it, the source is pulled back to it (contact3d.hpp):
-// a thinner sliver would need elements of its own thickness.
-constexpr double kClearanceFraction = 0.5;
-constexpr int kClearanceAttempts = 5;
 using detail::crossing_vertex;
 using detail::free_vertex;
 using detail::source_vertex;
 using detail::target_vertex;
-
-struct SurfaceFacts {
-  double volume = 0.0;  // positive: the faces are oriented outwards
-  double area = 0.0;
-  double mean_edge = 0.0;
-};
-
-// Measures a surface that passed check_closed_surface and require_volume (`volume`: the size of
-// its volume).
-SurfaceFacts measure_surface(const Points3Ref& vertices, const FacesRef& faces, double volume) {
-  SurfaceFacts facts;
-  facts.volume = volume;
-  facts.area = detail::surface_area(vertices, faces);
-  for (Index f = 0; f < faces.rows(); ++f) {
-    const Vec3 a = detail::corner(vertices, faces, f, 0), b = detail::corner(vertices, faces, f, 1),
-               c = detail::corner(vertices, faces, f, 2);
-    facts.mean_edge += ((b - a).norm() + (c - b).norm() + (a - c).norm()) / 3.0;
-  }
-  facts.mean_edge /= faces.rows();
-  return facts;
-}
 
 // The P1 solution on the tetrahedra: local stiffness volume * grad phi_i . grad phi_j.
 Vector solve_potential(const detail::ShellMesh& mesh, const std::vector<char>& kind) {
@@ -93,361 +48,6 @@ Vector solve_potential(const detail::ShellMesh& mesh, const std::vector<char>& k
         return Eigen::Matrix4d(volume * g * g.transpose());
       },
       true);
-}
-
-// Follows -grad c from the source boundary of the mesh to its target boundary. As in 2D, the P1
-// gradient (constant on each tetrahedron) is recovered at the vertices as the volume-weighted mean
-// over the tetrahedra around each, and normal to the surface at its Dirichlet vertices; that field
-// is interpolated linearly and integrated with RK4 steps of a fraction of the local element size,
-// each step followed as a straight segment from tetrahedron to tetrahedron until it stays inside
-// one or leaves the mesh through a face of the target.
-class Tracer {
- public:
-  Tracer(const detail::ShellMesh& mesh, const Vector& c, const std::vector<char>& kind) : mesh_(mesh), c_(c) {
-    const Index n = mesh.vertices.rows(), tets = mesh.tetrahedra.rows();
-    velocity_.assign(n, Vec3::Zero());
-    std::vector<double> weight(n, 0.0);
-    std::vector<Vec3> normal(n, Vec3::Zero());
-    step_.resize(tets);
-    // Where the surfaces cross, c jumps from 1 to 0 along a curve and no smooth fit holds: in the
-    // tetrahedra at such a curve the flow is the element's own -grad c (the P1 field), which
-    // points away from the source faces and out through the target faces. NaN elsewhere.
-    element_flow_.assign(tets, Vec3::Constant(kNaN));
-    gradients_.resize(static_cast<std::size_t>(tets));
-    for (Index t = 0; t < tets; ++t) {
-      Eigen::Matrix<double, 4, 3>& g = gradients_[static_cast<std::size_t>(t)];
-      const double volume = std::abs(detail::tetrahedron_gradients(mesh.vertices, mesh.tetrahedra, t, g));
-      Vec3 flow = Vec3::Zero();
-      bool at_crossing = false;
-      for (int i = 0; i < 4; ++i) {
-        flow -= c[mesh.tetrahedra(t, i)] * g.row(i).transpose();
-        at_crossing = at_crossing || kind[mesh.tetrahedra(t, i)] == crossing_vertex;
-      }
-      if (at_crossing) element_flow_[t] = flow;
-      double edges = 0.0;
-      for (int i = 0; i < 4; ++i) {
-        const Index v = mesh.tetrahedra(t, i);
-        velocity_[v] += volume * flow;
-        weight[v] += volume;
-        for (int j = i + 1; j < 4; ++j) edges += (point(v) - point(mesh.tetrahedra(t, j))).norm();
-      }
-      step_[t] = 0.25 * edges / 6.0;
-      for (int i = 0; i < 4; ++i) {
-        if (mesh.patches(t, i) != detail::source_face && mesh.patches(t, i) != detail::target_face) continue;
-        // Boundary face opposite vertex i: its (unnormalised) normal, the sign does not matter.
-        const Index a = mesh.tetrahedra(t, (i + 1) % 4), b = mesh.tetrahedra(t, (i + 2) % 4),
-                    d = mesh.tetrahedra(t, (i + 3) % 4);
-        Vec3 m = (point(b) - point(a)).cross(point(d) - point(a));
-        if (m.dot(point(a) - point(mesh.tetrahedra(t, i))) < 0.0) m = -m;  // outwards
-        for (const Index v : {a, b, d}) normal[v] += m;
-      }
-    }
-    for (Index v = 0; v < n; ++v) {
-      if (weight[v] > 0.0) velocity_[v] /= weight[v];
-    }
-    recover_by_least_squares(c);
-    for (Index v = 0; v < n; ++v) {
-      // On the surfaces c is constant, so the flow is normal to them: into the region at the
-      // source (c = 1 is its maximum), out of it at the target. The fit only gives the speed (its
-      // sign may be wrong near a crossing curve, where c jumps).
-      if ((kind[v] == source_vertex || kind[v] == target_vertex) && normal[v].squaredNorm() > 0.0) {
-        const Vec3 outwards = normal[v].normalized();
-        const double speed = std::abs(velocity_[v].dot(outwards));
-        velocity_[v] = (kind[v] == source_vertex ? -speed : speed) * outwards;
-      }
-    }
-  }
-
-  // From x on the boundary face of tetrahedron t. Returns the exit point on the target boundary
-  // of the mesh, or NaN.
-  Vec3 trace(Index t, Vec3 x, std::vector<Vec3>* path) const {
-    const Vec3 lost(kNaN, kNaN, kNaN);
-    if (path) path->push_back(x);
-    int stalled = 0;
-    for (int step = 0; step < kStepLimit; ++step) {
-      if (step % 1024 == 0) detail::check_interrupt();
-      const double h = step_[t];
-      const Vec3 k1 = direction(t, x);
-      if (k1.squaredNorm() == 0.0) return stopped(locate(t, x), x);
-      const Vec3 k2 = direction(t, x + 0.5 * h * k1), k3 = direction(t, x + 0.5 * h * k2),
-                 k4 = direction(t, x + h * k3);
-      const Vec3 y = x + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-      const Vec3 before = x;
-      const int outcome = walk(t, x, y);
-      if (path) path->push_back(x);
-      // Pressed against a boundary that is not the target, a streamline stops moving.
-      stalled = x == before ? stalled + 1 : 0;
-      if (stalled == kStallLimit) return stopped(t, x);
-      if (outcome == reached_target) return x;
-      if (outcome == lost_way) return lost;
-    }
-    return lost;
-  }
-
- private:
-  enum Outcome { inside = 0, reached_target = 1, lost_way = 2 };
-  static constexpr int kStepLimit = 100000;
-  static constexpr int kWalkLimit = 10000;
-  static constexpr int kStallLimit = 16;
-
-  Vec3 point(Index v) const { return mesh_.vertices.row(v).transpose(); }
-
-  // Where a streamline that stopped moving at x in tetrahedron t ends: at x if t touches a curve
-  // where the surfaces cross (the streamline has run into the curve, a point of the target) or
-  // has c = 0 at every corner (it is at the target's level), else nowhere (NaN).
-  Vec3 stopped(Index t, const Vec3& x) const {
-    bool level_zero = true;
-    for (int i = 0; i < 4; ++i) level_zero = level_zero && c_[mesh_.tetrahedra(t, i)] == 0.0;
-    if (level_zero || !std::isnan(element_flow_[t].x())) return x;
-    return Vec3::Constant(kNaN);
-  }
-
-  // The volume-weighted mean of the element gradients is only first-order accurate on an
-  // irregular mesh. Better: fit a quadratic to the nodal values around each vertex (its
-  // neighbours, and theirs where there are few), weighted by inverse squared distance; its
-  // gradient at the vertex is second-order accurate. The mean stays where the fit is singular.
-  void recover_by_least_squares(const Vector& c) {
-    const Index n = mesh_.vertices.rows();
-    const detail::CompressedRows ring = detail::neighbouring_vertices(n, mesh_.tetrahedra);
-    const auto ring_of = [&](Index v) {
-      return std::make_pair(ring.entries.begin() + ring.first[v], ring.entries.begin() + ring.first[v + 1]);
-    };
-    tbb::parallel_for(Index(0), n, [&](Index v) {
-      const auto [begin, end] = ring_of(v);
-      std::vector<Index> patch(begin, end);
-      if (patch.size() < 14) {
-        for (auto w = begin; w != end; ++w) {
-          const auto [from, to] = ring_of(*w);
-          patch.insert(patch.end(), from, to);
-        }
-        std::sort(patch.begin(), patch.end());
-        patch.erase(std::unique(patch.begin(), patch.end()), patch.end());
-        patch.erase(std::remove(patch.begin(), patch.end(), v), patch.end());
-      }
-      if (patch.size() < 12) return;
-      double h = 0.0;
-      for (const Index w : patch) h += (point(w) - point(v)).norm();
-      h /= static_cast<double>(patch.size());
-      Eigen::Matrix<double, 9, 9> normal_matrix = Eigen::Matrix<double, 9, 9>::Zero();
-      Eigen::Matrix<double, 9, 1> rhs = Eigen::Matrix<double, 9, 1>::Zero();
-      for (const Index w : patch) {
-        const Vec3 d = (point(w) - point(v)) / h;
-        const double weight = 1.0 / d.squaredNorm();
-        Eigen::Matrix<double, 9, 1> row;
-        row << d.x(), d.y(), d.z(), 0.5 * d.x() * d.x(), 0.5 * d.y() * d.y(), 0.5 * d.z() * d.z(), d.x() * d.y(),
-            d.y() * d.z(), d.z() * d.x();
-        normal_matrix += weight * row * row.transpose();
-        rhs += weight * (c[w] - c[v]) * row;
-      }
-      const Eigen::LDLT<Eigen::Matrix<double, 9, 9>> fit(normal_matrix);
-      if (fit.info() != Eigen::Success || !(fit.rcond() > 1e-10)) return;
-      const Eigen::Matrix<double, 9, 1> x = fit.solve(rhs);
-      if (!x.allFinite()) return;
-      velocity_[v] = -x.head<3>() / h;
-    });
-  }
-
-  // From the gradients of the barycentric coordinates, kept from the constructor: a streamline
-  // asks for them about ten times per step, and solving the tetrahedron's 3 x 3 system each time
-  // was most of the trace.
-  Vec4 barycentric(Index t, const Vec3& x) const {
-    Vec4 l = gradients_[static_cast<std::size_t>(t)] * (x - point(mesh_.tetrahedra(t, 0)));
-    l[0] += 1.0;
-    return l;
-  }
-
-  // The tetrahedron containing x, walking from t towards it; the last one reached if x lies
-  // outside the mesh (the field is then extrapolated from there).
-  // l: x's barycentric coordinates in the tetrahedron returned.
-  Index locate(Index t, const Vec3& x, Vec4& l) const {
-    for (int k = 0; k < kWalkLimit; ++k) {
-      l = barycentric(t, x);
-      int i;
-      if (l.minCoeff(&i) >= -1e-12) return t;
-      const Index next = mesh_.neighbours(t, i);
-      if (next < 0) return t;
-      t = next;
-    }
-    l = barycentric(t, x);
-    return t;
-  }
-  Index locate(Index t, const Vec3& x) const {
-    Vec4 l;
-    return locate(t, x, l);
-  }
-
-  Vec3 direction(Index t, const Vec3& x) const {
-    Vec4 l;
-    t = locate(t, x, l);
-    Vec3 u = element_flow_[t];
-    if (std::isnan(u.x())) {
-      u.setZero();
-      for (int i = 0; i < 4; ++i) u += l[i] * velocity_[mesh_.tetrahedra(t, i)];
-    }
-    const double norm = u.norm();
-    return norm > 0.0 ? Vec3(u / norm) : Vec3::Zero();
-  }
-
-  // Moves x along the straight segment to y, tetrahedron by tetrahedron. Sliding along a boundary
-  // that is not the target (the flow should not point into it but may, by a rounding of the
-  // recovered gradient near the source).
-  int walk(Index& t, Vec3& x, Vec3 y) const {
-    bool slid = false;
-    for (int k = 0; k < kWalkLimit; ++k) {
-      const Vec4 ly = barycentric(t, y);
-      if (ly.minCoeff() >= 0.0) {
-        x = y;
-        return inside;
-      }
-      const Vec4 lx = barycentric(t, x);
-      int face = -1;
-      double first = 2.0;
-      for (int i = 0; i < 4; ++i) {
-        if (ly[i] >= 0.0) continue;
-        const double a = std::max(lx[i], 0.0);
-        const double s = a / (a - ly[i]);
-        if (s < first || (s == first && face >= 0 && ly[i] < ly[face])) first = s, face = i;
-      }
-      const Vec3 p = x + first * (y - x);
-      const Index next = mesh_.neighbours(t, face);
-      if (next >= 0) {
-        t = next;
-        x = p;
-        continue;
-      }
-      x = p;
-      if (mesh_.patches(t, face) == detail::target_face) return reached_target;
-      if (slid) return inside;  // stop the step here
-      // Slide: the rest of the step projected onto the face's plane.
-      const Index a = mesh_.tetrahedra(t, (face + 1) % 4), b = mesh_.tetrahedra(t, (face + 2) % 4),
-                  d = mesh_.tetrahedra(t, (face + 3) % 4);
-      const Vec3 m = (point(b) - point(a)).cross(point(d) - point(a)).normalized();
-      y -= (y - p).dot(m) * m;
-      slid = true;
-    }
-    return lost_way;
-  }
-
-  const detail::ShellMesh& mesh_;
-  const Vector& c_;
-  std::vector<Vec3> velocity_;      // recovered -grad c at the vertices
-  std::vector<Vec3> element_flow_;  // -grad c of the tetrahedra at a crossing curve, else NaN
-  std::vector<double> step_;        // RK4 step length in each tetrahedron
-  // Gradients of each tetrahedron's barycentric coordinates (rows; tetrahedron_gradients).
-  std::vector<Eigen::Matrix<double, 4, 3>> gradients_;
-};
-
-// The streamlines from the corners of the source facets of the mesh, and the exit of a
-// streamline from any point of a facet interpolated linearly from its corners'. Tracing every
-// vertex of s1 cost time in proportion to s1's resolution, not the mesh's (50k streamlines at 100k
-// faces, from 3k corners), and was less accurate: a streamline from inside a facet starts along a
-// blend of its corners' normals, not the surface's, and such exits scatter about the smooth map
-// (measured against radial truth and a finer mesh in bench/README.md, session 16).
-class FacetNodes {
- public:
-  FacetNodes(const detail::ShellMesh& mesh, const Faces& facets, const std::vector<Index>& source_facets)
-      : facets_(facets), source_facets_(source_facets), vertices_(mesh.vertices) {
-    std::vector<Index> node_of(static_cast<std::size_t>(mesh.vertices.rows()), -1);
-    corner_nodes_.resize(facets.rows(), 3);
-    for (Index k = 0; k < facets.rows(); ++k) {
-      for (int j = 0; j < 3; ++j) {
-        Index& node = node_of[static_cast<std::size_t>(facets(k, j))];
-        if (node < 0) {
-          node = static_cast<Index>(facet_of_.size());
-          facet_of_.push_back(k);
-          vertex_of_.push_back(facets(k, j));
-        }
-        corner_nodes_(k, j) = node;
-      }
-    }
-  }
-
-  // The exit of each corner of the wanted facets (NaN where its streamline was lost, and at the
-  // other corners), traced from the first facet it is a corner of.
-  Points3 trace(const Tracer& tracer, const std::vector<char>& wanted_facets) const {
-    const Index count = static_cast<Index>(facet_of_.size());
-    std::vector<char> wanted(static_cast<std::size_t>(count), 0);
-    for (Index k = 0; k < facets_.rows(); ++k) {
-      if (!wanted_facets[static_cast<std::size_t>(k)]) continue;
-      for (int j = 0; j < 3; ++j) wanted[static_cast<std::size_t>(corner_nodes_(k, j))] = 1;
-    }
-    Points3 exits = Points3::Constant(count, 3, kNaN);
-    tbb::parallel_for(Index(0), count, [&](Index n) {
-      const auto node = static_cast<std::size_t>(n);
-      if (!wanted[node]) return;
-      const Vec3 start = vertices_.row(vertex_of_[node]).transpose();
-      exits.row(n) =
-          tracer.trace(source_facets_[static_cast<std::size_t>(facet_of_[node])] / 4, start, nullptr).transpose();
-    });
-    return exits;
-  }
-
-  // The exit from x on facet k; NaN where a corner's streamline was lost.
-  Vec3 interpolate(const Points3& exits, Index k, const Vec3& x) const {
-    const Vec3 a = vertices_.row(facets_(k, 0)).transpose(), b = vertices_.row(facets_(k, 1)).transpose(),
-               c = vertices_.row(facets_(k, 2)).transpose();
-    const Vec3 e1 = b - a, e2 = c - a, d = x - a;
-    const double g11 = e1.dot(e1), g12 = e1.dot(e2), g22 = e2.dot(e2), r1 = d.dot(e1), r2 = d.dot(e2);
-    const double det = g11 * g22 - g12 * g12;
-    if (!(det > 0.0)) return Vec3::Constant(kNaN);
-    const double l1 = (g22 * r1 - g12 * r2) / det, l2 = (g11 * r2 - g12 * r1) / det;
-    return (1.0 - l1 - l2) * exits.row(corner_nodes_(k, 0)).transpose() +
-           l1 * exits.row(corner_nodes_(k, 1)).transpose() + l2 * exits.row(corner_nodes_(k, 2)).transpose();
-  }
-
- private:
-  const Faces& facets_;
-  const std::vector<Index>& source_facets_;
-  const Points3& vertices_;
-  std::vector<Index> facet_of_;   // each corner node: the first facet it is a corner of
-  std::vector<Index> vertex_of_;  // and its mesh vertex
-  Eigen::Matrix<Index, Eigen::Dynamic, 3, Eigen::RowMajor> corner_nodes_;
-};
-
-// The source cleared of its contact with the target (contact3d.hpp), and how it then lies
-// against the target. Pulling back may make the source meet itself (a sliver of marching cubes
-// turned over, a neck narrower than the clearance): then again with half the clearance, down to
-// 1/32 of the edge (fuzz seed 5022 needed 1/16), before the contact is refused.
-struct Cleared {
-  detail::ClearedSource source;
-  detail::Nesting nesting;
-  std::unique_ptr<const detail::ClosedSurface> surface;  // of the source when it moved (else none)
-};
-
-Cleared clear_and_classify(const Points3Ref& source_vertices, const FacesRef& source_faces,
-                           const Points3Ref& target_vertices, const FacesRef& target_faces,
-                           const detail::ClosedSurface& target_surface, const SurfaceIndex& target_index,
-                           double finer_edge, detail::Nesting nesting) {
-  double fraction = kClearanceFraction;
-  for (int attempt = 0;; ++attempt, fraction *= 0.5) {
-    Cleared cleared{detail::clear_contact(source_vertices, source_faces, target_vertices, target_faces, target_surface,
-                                          target_index, fraction * finer_edge, kTouchFraction * finer_edge),
-                    nesting, nullptr};
-    if (cleared.source.moved == 0) return cleared;
-    try {
-      cleared.surface = std::make_unique<const detail::ClosedSurface>(cleared.source.vertices, source_faces);
-      cleared.nesting = detail::classify_nesting(*cleared.surface, target_surface);
-      return cleared;
-    } catch (const InvalidInput&) {
-      if (attempt == kClearanceAttempts - 1) {
-        Index touching = 0;
-        for (const char t : cleared.source.touching) touching += t;
-        throw InvalidInput("s2: comes within " + std::to_string(fraction * finer_edge) + " of s1 over a patch (" +
-                           std::to_string(cleared.source.moved) + " vertices, " + std::to_string(touching) +
-                           " touching), and pulling s1 back from it there makes s1 intersect itself; diffusion "
-                           "cannot map these surfaces: use 'auto' (which falls back) or 'normal'");
-      }
-    }
-  }
-}
-
-// The largest element size when the caller gives none: a quarter of the mean gap, four elements
-// across the shell. In a thin shell (frames a voxel apart) that is finer than the surfaces'
-// own spacing, and the tetrahedra grow as the area over the gap squared (a 2.5k-vertex swell pair
-// 0.76 voxel apart: 970k tetrahedra, over a minute); there half the spacing is fine enough, but
-// never more than half the gap, two elements across. Measured in bench/README.md ("Thin shells").
-double default_cell_size(double gap, double spacing) {
-  return std::max(0.25 * gap, std::min(0.5 * gap, 0.5 * spacing));
 }
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
@@ -499,113 +99,15 @@ ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, con
 ShellDiffusionSolution detail::solve_diffusion_3d(const ShellPair& pair, const ShellDiffusionOptions& options,
                                                   const LocalDiffusion* local) {
   const Points3Ref& source_vertices = pair.source_vertices;
-  const Points3Ref& target_vertices = pair.target_vertices;
-  const SurfaceFacts source = measure_surface(source_vertices, pair.source_faces, pair.source_volume);
-  const SurfaceFacts target = measure_surface(target_vertices, pair.target_faces, pair.target_volume);
+  const SurfaceIndex& target_index = pair.target_index;
   const auto stage = [&](const char* name) {
     if (options.on_stage) options.on_stage(name);
   };
   stage("mesh");
   auto clock = std::chrono::steady_clock::now();
-  detail::Nesting nesting = pair.nesting;
-  const detail::ClosedSurface& given_source = pair.source;
-  const detail::ClosedSurface& target_surface = pair.target;
-  const SurfaceIndex& target_index = pair.target_index;
-  const double finer_edge = std::min(source.mean_edge, target.mean_edge);
-  const Cleared cleared_pair = clear_and_classify(source_vertices, pair.source_faces, target_vertices,
-                                                  pair.target_faces, target_surface, target_index, finer_edge, nesting);
-  const detail::ClearedSource& cleared = cleared_pair.source;
-  nesting = cleared_pair.nesting;
-  // Bodies that only touch from outside count as crossing until the contact is cleared.
-  if (nesting == detail::Nesting::disjoint) {
-    throw InvalidInput(
-        "s2: only touches s1 from outside (the surfaces neither cross nor enclose one another); "
-        "diffusion mapping needs surfaces that overlap");
-  }
-  // From here on the source is the cleared one: it bounds the region that is meshed and solved.
-  const Points3& source_region = cleared.vertices;
-  const detail::ClosedSurface& source_surface = cleared_pair.surface ? *cleared_pair.surface : given_source;
-  std::unique_ptr<detail::CrossingRegion> crossing;
-  if (nesting == detail::Nesting::crossing) {
-    crossing = std::make_unique<detail::CrossingRegion>(source_surface, target_surface);
-  }
-
-  // Sizes: the input spacing at each surface, growing by a tenth of the distance from it, never
-  // above mesh_size (default: a quarter of the mean gap, the region's volume over the mean area of
-  // the surfaces). Measured between spheres of radii 1 and 4: the end-point error falls about
-  // linearly with the element size in the bulk, and removing slivers (exude) buys more accuracy
-  // than it costs time.
-  const double volume = crossing ? crossing->volume() : std::abs(target.volume - source.volume);
-  // Where the surfaces touch, they bound no region: leave that part out of the mean.
-  const double gap = volume / std::max(0.5 * (source.area + target.area) - cleared.near_area, 0.05 * source.area);
-  // The input spacing: the mean edge, but not finer than 1.5% of a surface's diagonal: a finer
-  // spacing describes the surface, not a shape the field must resolve (where the surface curves,
-  // facet_distance refines), and following it made the mesh grow with the surfaces' resolution
-  // (five times the tetrahedra, eight times the time, for a lumpy pair of 100k faces). 1.5%
-  // rather than 1%: an organ pair's ends then move by about a quarter of a percent of the gap from
-  // a much finer mesh's, less than the concentric spheres' row errs by, with fewer than half the
-  // tetrahedra (bench/README.md, session 14). Near the source, where the streamlines start, the
-  // elements stay within a fraction of the source's size however coarse its triangles are (the end
-  // error follows the element size there: concentric spheres r = 1 -> 4 with 642 vertices gave
-  // RMS 0.018 at the triangles' size).
-  const double source_diagonal = (source_vertices.colwise().maxCoeff() - source_vertices.colwise().minCoeff()).norm();
-  const double target_diagonal = (target_vertices.colwise().maxCoeff() - target_vertices.colwise().minCoeff()).norm();
-  const double source_spacing = std::max(source.mean_edge, kFinestFraction * source_diagonal);
-  const double target_spacing = std::max(target.mean_edge, kFinestFraction * target_diagonal);
-  detail::ShellMeshCriteria criteria;
-  criteria.cell_size =
-      options.mesh_size > 0.0 ? options.mesh_size : default_cell_size(gap, std::min(source_spacing, target_spacing));
-  criteria.source_size = std::min({source_spacing, criteria.cell_size, kSourceFraction * source_diagonal});
-  criteria.target_size = std::min(target_spacing, criteria.cell_size);
-  criteria.grading = 0.1;
-  criteria.exude = true;
-  criteria.parallel = !options.repeatable && !crossing;
-  if (local != nullptr) {
-    if (crossing) throw GeometryError("diffusion for part of s1 needs nested surfaces");
-    criteria.focus = local->focus;
-    criteria.focus_radius = local->radius;
-    criteria.focus_grading = kFocusGrading;
-    criteria.coarsening = kCoarsening;
-  }
-  // Between nested surfaces the boundary facets may stray a fifth of the element size from the
-  // surfaces: at 0.05 Mesh_3 chased every crease of an unsmoothed marching-cubes surface (fuzz
-  // seed 1882337550, a 2k-vertex swell pair: 917k tetrahedra, 128 s; at 0.2: 265k, 15 s), while
-  // the concentric spheres' and the Figure 12 pair's accuracy stays (bench/README.md) and the
-  // folds its slivers cost are repaired. Where the surfaces cross, the pieces taper to wedges at
-  // the crossing curves and their facets must follow the surfaces closely (at 0.2 the round trip
-  // of the crossing pair grew from 2.4e-3 to 6.0e-3 RMS, and ends near the curve fell on the
-  // wrong side).
-  criteria.facet_distance =
-      (crossing ? kFacetDistanceCrossing : kFacetDistanceNested) * std::min(criteria.source_size, criteria.target_size);
-  // In a child process (see mesh_in_child.hpp); after a crash, again with other random choices
-  // and sizes a little finer (the crashes come and go with both).
-  detail::ShellMesh mesh;
-  const detail::ShellMeshCriteria requested = criteria;
-  for (int attempt = 0;; ++attempt) {
-    const double finer = 1.0 - 0.15 * attempt;
-    criteria.seed = attempt;
-    criteria.cell_size = finer * requested.cell_size;
-    criteria.source_size = finer * requested.source_size;
-    criteria.target_size = finer * requested.target_size;
-    criteria.facet_distance = finer * requested.facet_distance;
-    try {
-      const auto make = [&](bool threads) {
-        detail::ShellMeshCriteria used = criteria;
-        used.parallel = criteria.parallel && threads;
-        return crossing ? crossing->mesh(used)
-                        : detail::mesh_shell(source_surface, target_surface, nesting == detail::Nesting::source_inside,
-                                             used);
-      };
-      mesh = criteria.parallel ? detail::mesh_in_child_threaded(make, kMeshing)
-                               : detail::mesh_in_child([&] { return make(false); }, kMeshing);
-      break;
-    } catch (const detail::MesherCrashed& crash) {
-      if (attempt + 1 == kMeshAttempts) {
-        throw GeometryError(std::string(crash.what()) + " in " + std::to_string(kMeshAttempts) +
-                            " attempts; try another mesh_size");
-      }
-    }
-  }
+  const detail::ShellRegion region = detail::mesh_shell_region(pair, options, local);
+  const detail::ShellMesh& mesh = region.mesh;
+  const detail::ClearedSource& cleared = region.cleared;
 
   ShellDiffusionSolution solution;
   solution.seconds.mesh = seconds_since(clock);
@@ -632,54 +134,11 @@ ShellDiffusionSolution detail::solve_diffusion_3d(const ShellPair& pair, const S
   solution.seconds.solve = seconds_since(clock);
   stage("trace");
   clock = std::chrono::steady_clock::now();
-
-  // Start points: the closest point of the mesh's source boundary to each source vertex.
-  Faces facets(static_cast<Index>(source_facets.size()), 3);
-  for (std::size_t k = 0; k < source_facets.size(); ++k) {
-    const Index t = source_facets[k] / 4;
-    const int i = static_cast<int>(source_facets[k] % 4);
-    for (int j = 1; j < 4; ++j) facets(static_cast<Index>(k), j - 1) = mesh.tetrahedra(t, (i + j) % 4);
-  }
-  // (A vertex on an edge or corner that several facets share takes the lowest facet, whatever
-  // the traversal: SurfaceIndex's tie rule, which keeps the ends repeatable bit for bit.)
-  const SurfaceHits starts = SurfaceIndex(mesh.vertices, facets).closest_points(source_region);
-
-  const Tracer tracer(mesh, solution.potential, kind);
+  detail::ShellExits traced = detail::trace_exits(mesh, solution.potential, kind, source_facets, source_vertices,
+                                                  cleared.vertices, local, options.keep_streamlines);
+  const Points3& exits = traced.exits;
+  std::vector<std::vector<Vec3>>& paths = traced.paths;
   const Index ns = source_vertices.rows();
-  Points3 exits(ns, 3);
-  // The vertices that get an exit: all of them, or those a local diffusion traces (else NaN).
-  const auto wanted = [&](Index i) { return local == nullptr || local->traced[static_cast<std::size_t>(i)] != 0; };
-  // Each wanted vertex's exit is interpolated from the streamlines of the corners of its facet
-  // (FacetNodes: only the facets that hold such a vertex); where one of those was lost, and when
-  // the streamlines are kept, the vertex is traced itself.
-  std::vector<char> interpolated(static_cast<std::size_t>(ns), 0);
-  if (!options.keep_streamlines) {
-    const FacetNodes nodes(mesh, facets, source_facets);
-    std::vector<char> wanted_facets(source_facets.size(), 0);
-    for (Index i = 0; i < ns; ++i) {
-      if (wanted(i)) wanted_facets[static_cast<std::size_t>(starts.faces[i])] = 1;
-    }
-    const Points3 node_exits = nodes.trace(tracer, wanted_facets);
-    tbb::parallel_for(Index(0), ns, [&](Index i) {
-      if (!wanted(i)) return;
-      const Vec3 exit = nodes.interpolate(node_exits, starts.faces[i], starts.points.row(i).transpose());
-      if (std::isnan(exit.x())) return;
-      exits.row(i) = exit.transpose();
-      interpolated[static_cast<std::size_t>(i)] = 1;
-    });
-  }
-  std::vector<std::vector<Vec3>> paths(options.keep_streamlines ? ns : 0);
-  tbb::parallel_for(Index(0), ns, [&](Index i) {
-    if (interpolated[static_cast<std::size_t>(i)]) return;
-    if (!wanted(i)) {
-      exits.row(i).setConstant(kNaN);
-      return;
-    }
-    const Index t = source_facets[starts.faces[i]] / 4;
-    std::vector<Vec3>* path = options.keep_streamlines ? &paths[i] : nullptr;
-    if (path) path->push_back(source_vertices.row(i).transpose());
-    exits.row(i) = tracer.trace(t, starts.points.row(i).transpose(), path).transpose();
-  });
 
   // The exit points lie on the mesh's approximation of the target: move them onto the surface.
   const std::vector<Index> reached = detail::finite_rows(exits);
