@@ -48,6 +48,7 @@ struct Problem {
   double stretch_weight = kDefaultStretchWeight;
   double alpha = 1.0;
   const ArcCurve* target = nullptr;
+  std::vector<double> vertex_arcs;      // arc position of each vertex of the target
   const MatchRegion* region = nullptr;  // the hard constraint, where the region is a polygon
 };
 
@@ -79,18 +80,48 @@ bool cross(const Vec2& a0, const Vec2& a1, const Vec2& b0, const Vec2& b1) {
 // those vectors lie inside it (row r, sample k at admitted[first[r] + k - lo[r]]).
 struct Level {
   std::vector<Index> rows;
-  Index samples = 0;  // M
+  Index samples = 0;         // M
+  std::vector<double> arcs;  // arc position of each of the M + 1 samples along the target
   std::vector<Index> lo, hi;
   std::vector<char> admitted;
   std::vector<Index> first;
 };
 
+// The arc positions of M + 1 target samples: each the mean of an equally spaced position and the
+// position the same fraction of the way through the target's vertices. Outlines are traced densely
+// where they have detail and sparsely along long edges (a flank closed by one segment, a pixel
+// staircase's runs): equally spaced samples alone are coarser than the points there, and the
+// stretch term, which compares arc lengths between neighbours, then only sees multiples of the
+// sample step (bench/README.md, "Real 2D outlines"). Strictly increasing; the ends exact.
+std::vector<double> sample_arcs(const Problem& p, Index samples) {
+  std::vector<double> t(samples + 1);
+  const Index last_vertex = static_cast<Index>(p.vertex_arcs.size()) - 1;
+  for (Index k = 0; k <= samples; ++k) {
+    const double u = static_cast<double>(k) / static_cast<double>(samples);
+    const double x = u * static_cast<double>(last_vertex);
+    const Index j = std::min<Index>(static_cast<Index>(x), last_vertex - 1);
+    const double f = x - static_cast<double>(j);
+    const double through_vertices = p.vertex_arcs[j] + f * (p.vertex_arcs[j + 1] - p.vertex_arcs[j]);
+    t[k] = 0.5 * (u * p.target_length + through_vertices);
+  }
+  t[0] = 0.0, t[samples] = p.target_length;
+  return t;
+}
+
+// The index of the sample nearest to arc position a.
+Index nearest_sample(const std::vector<double>& arcs, double a) {
+  const auto above = std::lower_bound(arcs.begin(), arcs.end(), a);
+  if (above == arcs.begin()) return 0;
+  if (above == arcs.end()) return static_cast<Index>(arcs.size()) - 1;
+  const Index k = static_cast<Index>(above - arcs.begin());
+  return a - arcs[k - 1] <= arcs[k] - a ? k - 1 : k;
+}
+
 // The M + 1 target samples, the ends exactly the pieces' ends.
-std::vector<Vec2> target_samples(const Problem& p, Index samples) {
-  const double step_length = p.target_length / static_cast<double>(samples);
-  std::vector<Vec2> q(samples + 1);
-  for (Index k = 0; k <= samples; ++k) q[k] = p.target->point_at(step_length * k);
-  q[0] = p.begin_target, q[samples] = p.end_target;
+std::vector<Vec2> target_samples(const Problem& p, const Level& level) {
+  std::vector<Vec2> q(level.samples + 1);
+  for (Index k = 0; k <= level.samples; ++k) q[k] = p.target->point_at(level.arcs[k]);
+  q[0] = p.begin_target, q[level.samples] = p.end_target;
   return q;
 }
 
@@ -98,8 +129,7 @@ std::vector<Vec2> target_samples(const Problem& p, Index samples) {
 // a side of the region itself and always admitted.
 void admit(const Problem& p, const std::vector<Index>& source_rows, Level& level) {
   const Index count = static_cast<Index>(level.rows.size());
-  const std::vector<Vec2> q = target_samples(p, level.samples);
-  const double step_length = p.target_length / static_cast<double>(level.samples);
+  const std::vector<Vec2> q = target_samples(p, level);
   level.first.assign(count, 0);
   Index cells = 0;
   for (Index r = 0; r < count; ++r) level.first[r] = cells, cells += std::max<Index>(0, level.hi[r] - level.lo[r] + 1);
@@ -110,7 +140,7 @@ void admit(const Problem& p, const std::vector<Index>& source_rows, Level& level
       const Index c = level.first[r] + k - level.lo[r];
       rows[c] = source_rows[level.rows[r]];
       ends.row(c) = q[k].transpose();
-      segments[c] = p.target->segment_at(step_length * k);
+      segments[c] = p.target->segment_at(level.arcs[k]);
     }
   }
   level.admitted = p.region->admits(rows, ends, segments);
@@ -136,9 +166,9 @@ Index max_step(Index samples, Index count) { return 8 * samples / (count + 1) + 
 bool solve_level(const Problem& p, const Level& level, std::vector<Index>& path, double& energy) {
   const Index count = static_cast<Index>(level.rows.size());
   const Index samples = level.samples;
-  const double step_length = p.target_length / static_cast<double>(samples);
+  const std::vector<double>& t = level.arcs;
   const Index reach = max_step(samples, count);
-  const std::vector<Vec2> q = target_samples(p, samples);
+  const std::vector<Vec2> q = target_samples(p, level);
   // With the region every vector taken lies inside it, so none can cross another (optimal.hpp):
   // the crossing penalty is not needed.
   const bool constrained = !level.admitted.empty();
@@ -195,7 +225,7 @@ bool solve_level(const Problem& p, const Level& level, std::vector<Index>& path,
       for (Index kp = from; kp <= to; ++kp) {
         const double before = first ? 0.0 : cost[r - 1][kp - plo];
         if (before == kInf) continue;
-        double c = before + stretch(step_length * (k - kp), dl);
+        double c = before + stretch(t[k] - t[kp], dl);
         if (!(c < best)) continue;  // the crossing tests only where the step could win
         if (!first && !constrained && crosses_recent(level, back, r, kp, pi, q[k])) c += kCrossing;
         if (c < best) best = c, arg = kp;
@@ -212,7 +242,7 @@ bool solve_level(const Problem& p, const Level& level, std::vector<Index>& path,
     double c = cost[count - 1][k - level.lo[count - 1]];
     if (c == kInf) continue;
     if (!(p.pinned_last)) {
-      c += stretch(p.target_length - step_length * k, dl);
+      c += stretch(p.target_length - t[k], dl);
       if (!constrained && cross(p.starts.row(last).transpose(), q[k], p.end_source, p.end_target)) c += kCrossing;
     }
     if (c < best) best = c, arg = k;
@@ -261,7 +291,7 @@ bool solve_levels(const Problem& p, const std::vector<std::vector<Index>>& level
     const bool finest_level = level_rows + 1 == levels.rend();
     const Index count = static_cast<Index>(level.rows.size());
     level.samples = std::max(4 * (count + 1), (finest * (count + 1) + n) / (n + 1));
-    const double per_sample = p.target_length / static_cast<double>(level.samples);
+    level.arcs = sample_arcs(p, level.samples);
     const std::vector<double> centre =
         coarse_rows.empty() ? std::vector<double>() : carry(p, coarse_rows, coarse_t, level.rows);
     const Index first_band = std::max<Index>(16, 8 * level.samples / (count + 1));
@@ -273,7 +303,7 @@ bool solve_levels(const Problem& p, const std::vector<std::vector<Index>>& level
       for (Index r = 0; r < count; ++r) {
         auto [lo, hi] = feasible(p, r, count, level.samples);
         if (!centre.empty() && band < level.samples) {
-          const Index c = static_cast<Index>(std::llround(centre[r] / per_sample));
+          const Index c = nearest_sample(level.arcs, centre[r]);
           lo = std::max(lo, c - band), hi = std::min(hi, c + band);
         }
         level.lo[r] = lo, level.hi[r] = hi;
@@ -300,7 +330,7 @@ bool solve_levels(const Problem& p, const std::vector<std::vector<Index>>& level
     }
     coarse_rows = level.rows;
     coarse_t.resize(count);
-    for (Index r = 0; r < count; ++r) coarse_t[r] = per_sample * path[r];
+    for (Index r = 0; r < count; ++r) coarse_t[r] = level.arcs[path[r]];
   }
   return true;
 }
@@ -359,6 +389,9 @@ MonotoneMatch detail::monotone_match_unchecked(const Points2Ref& source, const s
   p.stretch_weight = stretch_weight;
   p.alpha = p.source_length > 0.0 ? p.target_length / p.source_length : 1.0;
   p.target = &curve;
+  p.vertex_arcs.assign(target.rows(), 0.0);
+  for (Index i = 1; i < target.rows(); ++i)
+    p.vertex_arcs[i] = p.vertex_arcs[i - 1] + (target.row(i) - target.row(i - 1)).norm();
   using Unchecked = detail::CurveIndexUnchecked;
   const double gap2 =
       Unchecked::closest_points(Unchecked::build(target, false), p.starts).distances.array().square().mean();
