@@ -98,7 +98,7 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
         way: start maps towards start). Two :class:`PreparedCurve` skip the checks and index
         building they have done once (prepared as ``closed`` says); one alone is used as its
         points.
-    method : {"auto", "minimal_distance", "normal", "diffusion", "uniform", "optimal", "best"}
+    method : {"auto", "minimal_distance", "normal", "diffusion", "uniform", "optimal", "paper", "best"}
         ``"minimal_distance"``: each start point to its closest point on C2.
         ``"normal"``: the line through each start point along its normal, both directions, to its
         nearest intersection with C2; NaN where it meets nothing.
@@ -108,13 +108,23 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
         minimises the sum of squared displacements of equally spaced points.
         ``"diffusion"``: streamlines of Laplace's equation between the curves (c = 1 on C1, 0 on C2;
         see :func:`solve_diffusion`) from each start point to C2.
-        ``"auto"`` (the default; the paper's Algorithm 1): split at intersections, normal mapping
-        on each pair of segments, and reverse diffusion for a pair where normal mapping gives
-        crossings or misses. Where reverse diffusion fails on a pair (its region cannot be
-        meshed, streamlines stall), ``auto`` still answers: diffusion (also crossing-free), else
-        the normal mapping if it missed nothing (crossings and all), else minimal distance.
-        ``field.method`` tells which algorithm made each vector (``"reverse_diffusion"`` and
-        so on for vectors found from C2).
+        ``"auto"`` (the default): on each pair of segments between split points (or the whole
+        pair), the candidate without crossings (counted with the split points' own vectors) or
+        misses and of lowest QM on that pair, among normal mapping and ``"optimal"`` (both cost
+        milliseconds); where neither qualifies, diffusion, then minimal distance. Every candidate
+        maps the segment's own start points, so the field has one vector per point of C1 (and per
+        crossing), in order along C1. Where no candidate qualifies on a pair, or the pairs' fields
+        cross each other, :class:`GeometryError` says how many start points and where: the
+        default never returns a crossing or incomplete field. Why not Algorithm 1: on real
+        outlines its reverse diffusion vectors cross where the streamlines fan into a lobe, and
+        they start from C2's points (bench/README.md, "Real 2D outlines").
+        ``"paper"``: the paper's Algorithm 1 as stated (Tables 1 and 2 and its figures): split at
+        intersections, normal mapping on each pair of segments, and reverse diffusion for a pair
+        where normal mapping gives crossings or misses. Where reverse diffusion fails on a pair
+        (its region cannot be meshed, streamlines stall), it still answers: diffusion (also
+        crossing-free streamlines), else the normal mapping if it missed nothing (crossings and
+        all), else minimal distance. ``field.method`` tells which algorithm made each vector
+        (``"reverse_diffusion"`` and so on for vectors found from C2).
         ``"optimal"`` (beyond the paper): an order-preserving matching of each pair of segments
         between split points (crossings and contact stretches, as above), or of the whole closed
         curves cut open where the best cyclic shift puts C1's first point: the ends follow C2 in
@@ -164,7 +174,7 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
         Uniform mapping of closed curves that do not cross: the point of C1 nearest to ``anchor``
         maps onto the point of C2 nearest to it.
     density_threshold : float, optional
-        ``"auto"`` only, off by default: the paper's density rule. Where the start points of a pair
+        ``"paper"`` only, off by default: the paper's density rule. Where the start points of a pair
         of segments are denser than this — the mean distance from them to C2 over their mean
         spacing along C1, i.e. start points per gap — reverse minimal distance is tried before
         normal mapping (reverse diffusion still replaces it if it crosses or misses). The paper
@@ -176,7 +186,7 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
         stretch map to their closest point on C2 (``field.method`` says ``"minimal_distance"``).
         Default: 1% of the finer of the two curves' median point spacings; 0: exact contact only.
     mesh_size, mesh_fraction : float, optional
-        The diffusion mesh (also within ``"auto"``), as in :func:`solve_diffusion`.
+        The diffusion mesh (also within ``"auto"`` and ``"paper"``), as in :func:`solve_diffusion`.
     stretch_weight : float, optional
         ``"optimal"`` (also within ``"best"``): the weight of the stretch term against the
         squared displacements, default 10 (``_core.DEFAULT_STRETCH_WEIGHT``); 0 gives the

@@ -12,12 +12,13 @@
 
 namespace morphomap {
 
-enum class MapMethod { minimal_distance, normal, diffusion, uniform, automatic, optimal };
+enum class MapMethod { minimal_distance, normal, diffusion, uniform, automatic, optimal, paper };
 
 // Every MapMethod, in the order users see them listed. Their names (map_method_name) are the one
 // registry that the core's messages, the Python bindings, the command line and the demo read.
 constexpr MapMethod kMapMethods[] = {MapMethod::automatic, MapMethod::minimal_distance, MapMethod::normal,
-                                     MapMethod::diffusion, MapMethod::uniform,          MapMethod::optimal};
+                                     MapMethod::diffusion, MapMethod::uniform,          MapMethod::optimal,
+                                     MapMethod::paper};
 
 // "auto" for automatic, else the enumerator's name.
 const char* map_method_name(MapMethod method);
@@ -29,14 +30,14 @@ MapMethod map_method_named(const std::string& name);
 std::string quoted_method_names(const MapMethod* first, const MapMethod* last);
 
 struct CurveMappingOptions {
-  MapMethod method = MapMethod::automatic;  // the paper's Algorithm 1
+  MapMethod method = MapMethod::automatic;  // the default's choice (map_curves below); paper: Algorithm 1
   bool closed = true;                       // both curves closed, or both open
   Index n = 0;                              // 0: the given points of the source curve are the start points;
                                             // > 0: both curves are first resampled to n equally spaced points
   bool reverse = false;                     // map C2 -> C1 and flip the vectors
   bool transform = false;                   // Appendix A: align a scaled C1 with C2 first, then carry back
   bool split = true;                        // map each pair of segments between intersection points on its own
-  double density_threshold = 0.0;           // "auto": where the start points of a pair of segments are
+  double density_threshold = 0.0;           // "paper": where the start points of a pair of segments are
                                             // denser than this many per gap (mean distance to C2 over
                                             // mean spacing), try reverse minimal distance before normal
                                             // mapping (the paper's density rule); 0: off
@@ -48,20 +49,30 @@ struct CurveMappingOptions {
   // the points on the stretch map to their closest point of the target; whatever `split` says.
   // < 0: 1% of the finer of the two curves' median segment lengths; 0: exact contact only.
   double contact_tolerance = -1.0;
-  DiffusionOptions diffusion;  // the mesh of diffusion mapping (also within "auto")
+  DiffusionOptions diffusion;  // the mesh of diffusion mapping (also within "auto" and "paper")
   // "optimal": the weight of the stretch term against the squared displacements (see
   // monotone_match in optimal.hpp); 0 gives the nearest order-preserving matching.
   double stretch_weight = kDefaultStretchWeight;
 };
 
 // Both curves must be simple (no self-intersection, one loop) and, when closed, enclose an area:
-// InvalidInput naming "c1" or "c2" otherwise. "auto" answers wherever a basic algorithm does:
-// where reverse diffusion fails on a piece it falls back to diffusion, then to normal mapping
-// (if that missed nothing), then to minimal distance; methods names what each vector used, with
-// reverse_ variants for vectors found from C2 (reverse = true flips every name). A vector that
-// found nothing keeps the point it came from: NaN ends on forward vectors, NaN starts on reverse
-// ones. With n > 0 the start and end points are put onto c1 and c2 as given (the resampled
-// curves cut their corners).
+// InvalidInput naming "c1" or "c2" otherwise.
+// "auto" (the default): on each piece between split points (or the whole pair), the candidate
+// with no crossings (counted with the split points' own vectors) and no misses and the lowest QM
+// on the piece, among normal mapping and the order-preserving optimal matching; where neither
+// qualifies, diffusion, then minimal distance. Every candidate maps the piece's own start points,
+// so the field has one vector per start point of C1 (and per crossing), in order along C1. Where
+// no candidate qualifies on a piece, or the pieces' fields cross each other, GeometryError says
+// how many start points and where: a crossing or incomplete field is never returned.
+// "paper": the paper's Algorithm 1 as stated: normal mapping on each piece, reverse diffusion where
+// it gives crossings or misses; where reverse diffusion fails on a piece (its mesh cannot be made,
+// streamlines stall) it falls back to diffusion, then to normal mapping (if that missed nothing),
+// then to minimal distance. Its reverse vectors start from C2's points, and straight vectors of
+// streamlines that curve can cross.
+// methods names what each vector used, with reverse_ variants for vectors found from C2 (reverse =
+// true flips every name). A vector that found nothing keeps the point it came from: NaN ends on
+// forward vectors, NaN starts on reverse ones. With n > 0 the start and end points are put onto c1
+// and c2 as given (the resampled curves cut their corners).
 DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2, const CurveMappingOptions& options = {});
 // The same on curves checked and indexed once (not checked again; their indices are reused),
 // with the same result bit for bit. Both must have been prepared as options.closed asks

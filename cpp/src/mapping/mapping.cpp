@@ -19,15 +19,14 @@
 #include "curves/inside.hpp"
 #include "curves/unchecked.hpp"
 #include "diffusion/laplace_unchecked.hpp"
-#include "mapping/optimal_unchecked.hpp"
-
-#include <unsupported/Eigen/FFT>
+#include "mapping/curve_job.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <complex>
 #include <limits>
 #include <memory>
+#include <string>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -55,350 +54,26 @@ Method reversed(Method method) {
 namespace {
 
 using detail::ArcCurve;
+using detail::basic_method;
+using detail::best_anchor;
+using detail::Job;
 using detail::Meeting;
+using detail::relative_direction;
+using detail::Settings;
+using detail::Vectors;
 
-// A piece of the source (the whole curve, or the stretch between two crossings) with its start
-// points, and the piece of the target it maps onto.
-struct Job {
-  Points2 source;  // the source polyline
-  bool source_closed = false;
-  std::vector<Index> start_rows;  // rows of source that are start points, in order along it
-  Points2 normals;                // normal mapping: the normal of the whole curve at each start
-  Vector fractions;               // uniform: arc position along the source / its length
-  Points2 target;
-  bool target_closed = false;
-  // The first / last rows of source and target are the two ends of a meeting (a crossing or a
-  // contact stretch), whose own vectors map them: no start point there, either way round.
-  bool shared_begin = false, shared_end = false;
-  double anchor = 0.0;  // uniform: target arc position where fraction 0 lands
-  int direction = 1;    // uniform: +1 forward along the target, -1 backward
-  // The query indexes of source and target, built on first use and shared by every attempt on
-  // the job (Algorithm 1 may try four) and by its reverse.
-  mutable std::shared_ptr<const CurveIndex> source_index, target_index;
-};
-
-const CurveIndex& target_index(const Job& job) {
-  if (!job.target_index) {
-    job.target_index = std::make_shared<const CurveIndex>(Unchecked::build(job.target, job.target_closed));
-  }
-  return *job.target_index;
-}
-
-// Vectors with the arc position of their start along the whole source curve, to order them.
-struct Vectors {
-  Points2 starts, ends;
-  std::vector<Method> methods;
-  std::vector<double> keys;
-};
-
-Points2 start_points(const Job& job) {
-  Points2 starts(job.start_rows.size(), 2);
-  for (std::size_t j = 0; j < job.start_rows.size(); ++j) starts.row(j) = job.source.row(job.start_rows[j]);
-  return starts;
-}
-
-// What every job of one mapping shares.
-struct Settings {
-  double density_threshold = 0.0;
-  double contact_tolerance = -1.0;  // < 0: default_contact_tolerance
-  DiffusionOptions diffusion;
-  double stretch_weight = kDefaultStretchWeight;  // "optimal"
-  // The curves are the ones map_curves checked to be simple (not resampled or transformed), so
-  // diffusion need not check them again.
-  bool simple_curves = false;
-};
-
-bool all_rows_equal(const Points2& points) {
-  for (Index i = 1; i < points.rows(); ++i) {
-    if (points.row(i) != points.row(0)) return false;
-  }
-  return true;
-}
-
-// Streamlines of one flow do not cross, but two that run a hair apart can come out swapped by
-// rounding and step error (seen where they converge onto a small curve): the ends, taken in the
-// order of their start points, are put back in order along the target, the set of ends kept.
-// Positions are unrolled step by step (the shorter way between neighbours on a closed curve), so
-// only local swaps move.
-void put_in_order(Points2& ends, const ArcCurve& target, const CurveIndex& target_index) {
-  const std::vector<Index> rows = detail::finite_rows(ends);
-  if (rows.size() < 2) return;
-  const Points2 found = ends(rows, Eigen::all);
-  const Vector arcs = Unchecked::closest_points(target_index, found).arc_lengths;
-  const double length = target.length();
-  std::vector<double> unrolled(rows.size(), 0.0);
-  for (std::size_t k = 1; k < rows.size(); ++k) {
-    double step = arcs[k] - arcs[k - 1];
-    if (target.closed()) step -= length * std::round(step / length);
-    unrolled[k] = unrolled[k - 1] + step;
-  }
-  const double direction = unrolled.back() >= 0.0 ? 1.0 : -1.0;
-  for (double& u : unrolled) u *= direction;
-  if (std::is_sorted(unrolled.begin(), unrolled.end())) return;
-  std::sort(unrolled.begin(), unrolled.end());
-  for (std::size_t k = 0; k < rows.size(); ++k) {
-    ends.row(rows[k]) = target.point_at(arcs[0] + direction * unrolled[k]).transpose();
-  }
-}
-
-double best_anchor(const ArcCurve& source, const ArcCurve& target, int direction);
-int relative_direction(const ArcCurve& source, const ArcCurve& target);
-
-// A closed curve cut open at arc position a: from the point there once round back to it.
-Points2 cut_open(const ArcCurve& curve, double a) {
-  a = curve.wrap(a);
-  std::vector<Vec2> rows{curve.point_at(a)};
-  for (Index v = 0; v < curve.size(); ++v) {
-    if (curve.arc(v) > a) rows.push_back(curve.points().row(v).transpose());
-  }
-  for (Index v = 0; v < curve.size(); ++v) {
-    if (curve.arc(v) < a) rows.push_back(curve.points().row(v).transpose());
-  }
-  rows.push_back(rows.front());
-  Points2 out(rows.size(), 2);
-  for (std::size_t r = 0; r < rows.size(); ++r) out.row(r) = rows[r].transpose();
-  return out;
-}
-
-// best_anchor's shift to within a hair: it is found on a grid of m samples, and a pinned start
-// point that is off by a fraction of a sample turns the whole matching by that much. Golden-section
-// search of the same sum of squared displacements over one grid step either side.
-double refined_anchor(const ArcCurve& source, const ArcCurve& target, double anchor) {
-  Index m = 64;
-  while (m < 2 * source.size()) m *= 2;
-  std::vector<Vec2> s(m);
-  for (Index j = 0; j < m; ++j) s[j] = source.point_at(source.length() * j / m);
-  auto cost = [&](double a) {
-    double sum = 0.0;
-    for (Index j = 0; j < m; ++j) sum += (s[j] - target.point_at(a + target.length() * j / m)).squaredNorm();
-    return sum;
-  };
-  const double ratio = 0.5 * (std::sqrt(5.0) - 1.0), bin = target.length() / m;
-  double lo = anchor - bin, hi = anchor + bin;
-  double x1 = hi - ratio * (hi - lo), x2 = lo + ratio * (hi - lo), f1 = cost(x1), f2 = cost(x2);
-  for (int iteration = 0; iteration < 20; ++iteration) {  // 0.618^20: 1e-4 of a step
-    if (f1 < f2) {
-      hi = x2, x2 = x1, f2 = f1, x1 = hi - ratio * (hi - lo), f1 = cost(x1);
-    } else {
-      lo = x1, x1 = x2, f1 = f2, x2 = lo + ratio * (hi - lo), f2 = cost(x2);
-    }
-  }
-  const double best = 0.5 * (lo + hi);
-  return cost(best) <= cost(anchor) ? best : anchor;
-}
-
-// "optimal" on one job. A piece (or open curves) is matched between its two ends. Whole closed
-// curves are cut open at the first start point and at the point of the target that the best
-// cyclic shift puts there (best_anchor), matched once round, then cut again at the start point
-// half way round and where the first matching took it, and matched again, so that the pinned
-// point of the first pass is free in the second; the lower energy wins.
-Points2 optimal_ends(const Job& job, double stretch_weight) {
-  if (!job.source_closed) {
-    return detail::monotone_match_unchecked(job.source, job.start_rows, job.target, stretch_weight).points;
-  }
-  const ArcCurve source = ArcCurve::unchecked(job.source, true);
-  const ArcCurve given = ArcCurve::unchecked(job.target, true);
-  const ArcCurve target = ArcCurve::unchecked(
-      relative_direction(source, given) > 0 ? given.points() : Points2(given.points().colwise().reverse()), true);
-  const Index n = source.size();
-  const Index count = static_cast<Index>(job.start_rows.size());
-  auto pass = [&](Index first, double anchor, MonotoneMatch& match) {
-    const Index h = job.start_rows[first];
-    Points2 rotated(n + 1, 2);
-    for (Index j = 0; j <= n; ++j) rotated.row(j) = source.points().row((h + j) % n);
-    std::vector<Index> rows(count);
-    for (Index k = 0; k < count; ++k) rows[k] = (job.start_rows[(first + k) % count] - h + n) % n;
-    match = detail::monotone_match_unchecked(rotated, rows, cut_open(target, anchor), stretch_weight);
-    Points2 ends(count, 2);
-    for (Index k = 0; k < count; ++k) ends.row((first + k) % count) = match.points.row(k);
-    return ends;
-  };
-  MonotoneMatch first, second;
-  const double anchor = refined_anchor(source, target, best_anchor(source, target, 1)) +
-                        source.arc(job.start_rows[0]) * target.length() / source.length();
-  Points2 ends = pass(0, anchor, first);
-  if (count < 2) return ends;
-  const Index half = count / 2;
-  Points2 other = pass(half, anchor + first.arcs[half], second);
-  return second.energy < first.energy ? other : ends;
-}
-
-Points2 basic_ends(MapMethod method, const Job& job, const Points2& starts, const Settings& settings) {
-  if (starts.rows() == 0) return Points2(0, 2);
-  // A piece of the target that shrank to a point (two meetings at one place) takes all starts.
-  if (all_rows_equal(job.target)) return job.target.row(0).replicate(starts.rows(), 1);
-  const ArcCurve target = ArcCurve::unchecked(job.target, job.target_closed);
-  switch (method) {
-    case MapMethod::minimal_distance:
-      return Unchecked::closest_points(target_index(job), starts).points;
-    case MapMethod::normal:  // unit normals
-      return Unchecked::line_intersections(target_index(job), starts, job.normals).points;
-    case MapMethod::uniform: {
-      Points2 ends(starts.rows(), 2);
-      for (Index i = 0; i < ends.rows(); ++i) {
-        const double s = job.anchor + job.direction * job.fractions[i] * target.length();
-        ends.row(i) = target.point_at(s).transpose();
-      }
-      return ends;
-    }
-    case MapMethod::diffusion: {
-      const DiffusionSolution solution =
-          settings.simple_curves
-              ? detail::solve_diffusion_unchecked(job.source, job.target, job.source_closed, settings.diffusion)
-              : solve_diffusion(job.source, job.target, job.source_closed, settings.diffusion);
-      Points2 ends(starts.rows(), 2);
-      for (std::size_t j = 0; j < job.start_rows.size(); ++j) ends.row(j) = solution.ends.row(job.start_rows[j]);
-      put_in_order(ends, target, target_index(job));
-      return ends;
-    }
-    case MapMethod::optimal:
-      return optimal_ends(job, settings.stretch_weight);
-    case MapMethod::automatic:
-      break;
-  }
-  detail::invalid("method", "not a basic algorithm");
-}
-
-Method basic_method(MapMethod method) {
-  switch (method) {
-    case MapMethod::minimal_distance:
-      return Method::minimal_distance;
-    case MapMethod::optimal:
-      return Method::optimal;
-    case MapMethod::normal:
-      return Method::normal;
-    case MapMethod::uniform:
-      return Method::uniform;
-    case MapMethod::diffusion:
-      return Method::diffusion;
-    case MapMethod::automatic:
-      break;
-  }
-  detail::invalid("method", "'auto' is not a basic algorithm");
-}
-
-// Start points per gap: the mean distance from the starts to the target over their mean spacing
-// along the source.
-double point_density(const Job& job, const Points2& starts) {
-  const double gap = Unchecked::closest_points(target_index(job), starts).distances.mean();
-  const double spacing = ArcCurve::unchecked(job.source, job.source_closed).length() / starts.rows();
-  return spacing > 0.0 ? gap / spacing : 0.0;
-}
-
-// A basic algorithm on one job, from its start points.
-Vectors forward(MapMethod method, const Job& job, const std::vector<double>& start_keys, const Settings& settings) {
-  Vectors v;
-  v.starts = start_points(job);
-  v.keys = start_keys;
-  v.ends = basic_ends(method, job, v.starts, settings);
-  v.methods.assign(v.starts.rows(), basic_method(method));
-  return v;
-}
-
-// A basic algorithm run backwards on one job (the paper's reverse mapping): from the target's
-// points (but shared crossings) to the source, flipped.
-Vectors reverse(MapMethod method, const Job& job, const ArcCurve& whole_source, const CurveIndex& whole_source_index,
-                const Settings& settings) {
-  Job back;
-  back.source = job.target;
-  back.source_closed = job.target_closed;
-  back.target = job.source;
-  back.target_closed = job.source_closed;
-  back.source_index = job.target_index;
-  back.target_index = job.source_index;
-  const Index n = job.target.rows();
-  for (Index i = 0; i < n; ++i) {
-    const bool shared =
-        !job.target_closed &&
-        ((i == 0 && (job.shared_begin || job.target.row(0) == job.source.row(0))) ||
-         (i == n - 1 && (job.shared_end || job.target.row(n - 1) == job.source.row(job.source.rows() - 1))));
-    if (!shared) back.start_rows.push_back(i);
-  }
-  Vectors v;
-  v.ends = start_points(back);
-  if (method == MapMethod::normal) {
-    back.normals = detail::normals_unchecked(back.source, back.source_closed)(back.start_rows, Eigen::all);
-  }
-  v.starts = basic_ends(method, back, v.ends, settings);
-  job.source_index = back.target_index, job.target_index = back.source_index;  // for the next attempt
-  v.methods.assign(v.starts.rows(), reversed(basic_method(method)));
-  v.keys.assign(v.starts.rows(), std::numeric_limits<double>::infinity());
-  const std::vector<Index> found = detail::finite_rows(v.starts);
-  if (!found.empty()) {
-    const Points2 located = v.starts(found, Eigen::all);
-    const Vector arcs = Unchecked::closest_points(whole_source_index, located).arc_lengths;
-    for (std::size_t j = 0; j < found.size(); ++j) v.keys[found[j]] = whole_source.wrap(arcs[j]);
-  }
-  // A miss keeps its point on the target (ends), so that it can be found; its start is NaN.
-  for (Index i = 0; i < v.starts.rows(); ++i) {
-    if (!v.starts.row(i).allFinite()) v.starts.row(i).setConstant(kNaN);
-  }
-  return v;
-}
-
-bool complete(const Vectors& v) { return v.starts.allFinite() && v.ends.allFinite(); }
-
-// One job with one algorithm. "auto" is the paper's Algorithm 1 on the job: normal mapping, and
-// reverse diffusion instead when normal mapping gives crossings or misses (with a density
-// threshold, the first attempt is reverse minimal distance where the start points are denser
-// than the threshold: the paper's "limiting case of an infinite number of points"). Where reverse
-// diffusion fails on a piece (its mesh cannot be made, streamlines stall), "auto" still answers:
-// forward diffusion, which is crossing-free too; then the first attempt if it missed nothing
-// (crossings and all); then minimal distance, which always finds a point.
+// One job with one method: the default's choice, the paper's Algorithm 1, or a basic algorithm.
 Vectors run(MapMethod method, const Job& job, const std::vector<double>& start_keys, const ArcCurve& whole_source,
             const CurveIndex& whole_source_index, const Settings& settings) {
   detail::check_interrupt();
-  if (method != MapMethod::automatic) return forward(method, job, start_keys, settings);
-  if (job.start_rows.empty()) return forward(MapMethod::normal, job, start_keys, settings);
-  const Vectors first =
-      settings.density_threshold > 0.0 && point_density(job, start_points(job)) > settings.density_threshold
-          ? reverse(MapMethod::minimal_distance, job, whole_source, whole_source_index, settings)
-          : forward(MapMethod::normal, job, start_keys, settings);
-  if (complete(first) && count_crossings(first.starts, first.ends) == 0) return first;
-  for (const bool backwards : {true, false}) {
-    try {
-      Vectors v = backwards ? reverse(MapMethod::diffusion, job, whole_source, whole_source_index, settings)
-                            : forward(MapMethod::diffusion, job, start_keys, settings);
-      // (A reverse mapping from a target piece without points of its own between the two
-      // meetings has no vectors at all: that leaves the piece of C1 unmapped, not complete.)
-      if (complete(v) && v.starts.rows() > 0) return v;
-    } catch (const GeometryError&) {
-    } catch (const InvalidInput&) {  // a piece the region of which is not what diffusion needs
-    }
+  switch (method) {
+    case MapMethod::automatic:
+      return detail::default_choice(job, start_keys, whole_source, whole_source_index, settings);
+    case MapMethod::paper:
+      return detail::paper_algorithm(job, start_keys, whole_source, whole_source_index, settings);
+    default:
+      return detail::forward(method, job, start_keys, settings);
   }
-  if (complete(first)) return first;
-  return forward(MapMethod::minimal_distance, job, start_keys, settings);
-}
-
-// Closed curves without a known pair of anchors: the start of the target (walking in direction)
-// such that equally spaced points of both curves, matched in order, are closest in the sum of
-// squared displacements. A circular cross-correlation by FFT over 2^k samples.
-double best_anchor(const ArcCurve& source, const ArcCurve& target, int direction) {
-  Index m = 64;
-  while (m < 2 * source.size()) m *= 2;
-  std::vector<std::complex<double>> s(m), t(m), fs, ft, product(m), correlation;
-  for (Index j = 0; j < m; ++j) {
-    const Vec2 p = source.point_at(source.length() * j / m);
-    const Vec2 q = target.point_at(direction * target.length() * j / m);
-    s[j] = {p.x(), p.y()};
-    t[j] = {q.x(), q.y()};
-  }
-  Eigen::FFT<double> fft;
-  fft.fwd(fs, s);
-  fft.fwd(ft, t);
-  for (Index j = 0; j < m; ++j) product[j] = std::conj(fs[j]) * ft[j];
-  fft.inv(correlation, product);
-  // sum_i |s_i - t_{i+k}|^2 is smallest where Re sum_i conj(s_i) t_{i+k} is largest.
-  Index best = 0;
-  for (Index k = 1; k < m; ++k) {
-    if (correlation[k].real() > correlation[best].real()) best = k;
-  }
-  return direction * target.length() * best / m;
-}
-
-// +1 when both closed curves turn the same way.
-int relative_direction(const ArcCurve& source, const ArcCurve& target) {
-  return detail::orientation_unchecked(source.points()) == detail::orientation_unchecked(target.points()) ? 1 : -1;
 }
 
 // Stacks the vectors of all jobs in the order of their keys (arc position of the start along the
@@ -577,7 +252,8 @@ Vectors map_directed(const Points2& source_points, const Points2& target_points,
   const auto whole_source_index = index_of(source.points(), closed, source_given);
   const auto whole_target_index = index_of(target.points(), closed, target_given);
   const Index n = source.size();
-  const bool wants_normals = method == MapMethod::normal || method == MapMethod::automatic;
+  const bool wants_normals =
+      method == MapMethod::normal || method == MapMethod::automatic || method == MapMethod::paper;
   const Points2 source_normals = wants_normals ? detail::normals_unchecked(source.points(), closed) : Points2();
   const int direction = closed ? relative_direction(source, target) : 1;
 
@@ -635,7 +311,8 @@ Vectors map_directed(const Points2& source_points, const Points2& target_points,
   Vectors& fixed = parts[0];
   std::vector<Vec2> fixed_starts, fixed_ends;
   std::vector<Method> fixed_methods;
-  const Method crossing_method = basic_method(method == MapMethod::automatic ? MapMethod::normal : method);
+  const Method crossing_method =
+      basic_method(method == MapMethod::automatic || method == MapMethod::paper ? MapMethod::normal : method);
   for (const Meeting& m : meetings) {
     if (!m.crossing) continue;
     fixed_starts.push_back(m.source_point_begin), fixed_ends.push_back(m.source_point_begin);
@@ -680,7 +357,19 @@ Vectors map_directed(const Points2& source_points, const Points2& target_points,
     for (std::size_t j = 0; j < m.size(); ++j) keys[j] = source.arc(m[j]);
     parts.push_back(run(method, job, keys, source, *whole_source_index, settings));
   }
-  return gather(parts);
+  Vectors all = gather(parts);
+  // The default chose each piece crossing-free; vectors of two pieces can still cross where their
+  // regions overlap (a piece's vectors reaching past a split point): said, never returned.
+  if (method == MapMethod::automatic) {
+    const auto pairs = crossing_pairs(all.starts, all.ends);
+    if (!pairs.empty()) {
+      const Vec2 at = all.starts.row(pairs[0].first).transpose();
+      throw GeometryError("map_curves: the fields of the pieces between the curves' split points cross each other (" +
+                          std::to_string(pairs.size()) + " crossing pairs, the first from (" + std::to_string(at.x()) +
+                          ", " + std::to_string(at.y()) + ")); try method='best' or split=False");
+    }
+  }
+  return all;
 }
 
 // Puts the finite rows of points onto the curve (their closest points).

@@ -40,6 +40,8 @@ const char* map_method_name(MapMethod method) {
   switch (method) {
     case MapMethod::automatic:
       return "auto";
+    case MapMethod::paper:
+      return "paper";
     case MapMethod::minimal_distance:
       return "minimal_distance";
     case MapMethod::normal:

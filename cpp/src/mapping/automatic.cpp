@@ -1,0 +1,224 @@
+// The default ("auto") and the paper's Algorithm 1 ("paper") on one job of map_curves.
+#include <morphomap/crossings.hpp>
+#include <morphomap/errors.hpp>
+#include <morphomap/quality.hpp>
+
+#include "common/interrupt_check.hpp"
+#include "common/validation.hpp"
+#include "curves/arc_curve.hpp"
+#include "curves/unchecked.hpp"
+#include "mapping/curve_job.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+#include <limits>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace morphomap::detail {
+
+namespace {
+
+using Unchecked = CurveIndexUnchecked;
+
+// Start points per gap: the mean distance from the starts to the target over their mean spacing
+// along the source.
+double point_density(const Job& job, const Points2& starts) {
+  const double gap = Unchecked::closest_points(target_index(job), starts).distances.mean();
+  const double spacing = ArcCurve::unchecked(job.source, job.source_closed).length() / starts.rows();
+  return spacing > 0.0 ? gap / spacing : 0.0;
+}
+
+}  // namespace
+
+// One job with one algorithm. "auto" is the paper's Algorithm 1 on the job: normal mapping, and
+// reverse diffusion instead when normal mapping gives crossings or misses (with a density
+// threshold, the first attempt is reverse minimal distance where the start points are denser
+// than the threshold: the paper's "limiting case of an infinite number of points"). Where reverse
+// diffusion fails on a piece (its mesh cannot be made, streamlines stall), "auto" still answers:
+// forward diffusion, which is crossing-free too; then the first attempt if it missed nothing
+// (crossings and all); then minimal distance, which always finds a point.
+Vectors paper_algorithm(const Job& job, const std::vector<double>& start_keys, const ArcCurve& whole_source,
+                        const CurveIndex& whole_source_index, const Settings& settings) {
+  if (job.start_rows.empty()) return forward(MapMethod::normal, job, start_keys, settings);
+  const Vectors first =
+      settings.density_threshold > 0.0 && point_density(job, start_points(job)) > settings.density_threshold
+          ? reverse(MapMethod::minimal_distance, job, whole_source, whole_source_index, settings)
+          : forward(MapMethod::normal, job, start_keys, settings);
+  if (complete(first) && count_crossings(first.starts, first.ends) == 0) return first;
+  for (const bool backwards : {true, false}) {
+    try {
+      Vectors v = backwards ? reverse(MapMethod::diffusion, job, whole_source, whole_source_index, settings)
+                            : forward(MapMethod::diffusion, job, start_keys, settings);
+      // (A reverse mapping from a target piece without points of its own between the two
+      // meetings has no vectors at all: that leaves the piece of C1 unmapped, not complete.)
+      if (complete(v) && v.starts.rows() > 0) return v;
+    } catch (const GeometryError&) {
+    } catch (const InvalidInput&) {  // a piece the region of which is not what diffusion needs
+    }
+  }
+  if (complete(first)) return first;
+  return forward(MapMethod::minimal_distance, job, start_keys, settings);
+}
+
+namespace {
+
+// The default's threshold for trying the diffusion candidates: a cheap candidate with a QM at most
+// this is kept (the real pairs' best fields have QM 1e-4 to 0.4; bench/README.md, "Real 2D
+// outlines"); above it the tenth of a second diffusion costs is worth spending.
+constexpr double kGoodEnough = 1.0;
+
+// One candidate of the default on one job, measured on the job's piece as best.py measures a piece:
+// its vectors with the meetings' own at the piece's ends.
+struct Scored {
+  Vectors vectors;
+  Index crossings = 0, misses = 0;
+  double qm = std::numeric_limits<double>::infinity();  // NaN measures rank last
+  std::string failure;                                  // why it is not admissible ("" when it is)
+};
+
+Scored measured(const Job& job, Vectors v) {
+  Scored s;
+  const Index m = v.starts.rows();
+  const Index b = job.shared_begin ? 1 : 0, e = job.shared_end ? 1 : 0;
+  DisplacementField2 f;
+  f.starts.resize(m + b + e, 2);
+  f.ends.resize(m + b + e, 2);
+  if (b) f.starts.row(0) = job.source.row(0), f.ends.row(0) = job.target.row(0);
+  f.starts.middleRows(b, m) = v.starts, f.ends.middleRows(b, m) = v.ends;
+  if (e) {
+    f.starts.row(m + b) = job.source.row(job.source.rows() - 1);
+    f.ends.row(m + b) = job.target.row(job.target.rows() - 1);
+  }
+  for (Index i = 0; i < m; ++i) s.misses += v.ends.row(i).allFinite() ? 0 : 1;
+  s.crossings = count_crossings(f.starts, f.ends);
+  if (s.misses > 0) s.failure = std::to_string(s.misses) + " misses";
+  if (s.crossings > 0) s.failure += (s.failure.empty() ? "" : ", ") + std::to_string(s.crossings) + " crossing pairs";
+  if (s.failure.empty()) {
+    try {
+      const double qm = quality(f, job.source, job.target, job.source_closed).qm;
+      if (std::isfinite(qm)) s.qm = qm;
+    } catch (const InvalidInput&) {  // a piece too degenerate to measure (a target shrunk to a point)
+    }
+  }
+  s.vectors = std::move(v);
+  return s;
+}
+
+// A reverse field (from the target's points) carried onto the job's own start points: each start
+// point's end lies the same fraction of the way along the target between the ends of the two
+// reverse vectors whose starts bracket it on the source (the piece's ends bracket the first and
+// the last). Open pieces only, and only where the reverse field keeps the order (else none).
+std::optional<Vectors> carried(const Vectors& back, const Job& job, const std::vector<double>& start_keys,
+                               Method label) {
+  if (job.source_closed || !complete(back) || back.starts.rows() == 0) return std::nullopt;
+  const ArcCurve source = ArcCurve::unchecked(job.source, false);
+  const ArcCurve target = ArcCurve::unchecked(job.target, false);
+  const Vector a = Unchecked::closest_points(Unchecked::build(job.source, false), back.starts).arc_lengths;
+  const Vector b = Unchecked::closest_points(target_index(job), back.ends).arc_lengths;
+  std::vector<std::pair<double, double>> knots{{0.0, 0.0}};
+  for (Index j = 0; j < a.size(); ++j) knots.emplace_back(a[j], b[j]);
+  knots.emplace_back(source.length(), target.length());
+  std::sort(knots.begin(), knots.end());
+  for (std::size_t k = 1; k < knots.size(); ++k) {
+    if (knots[k].second < knots[k - 1].second) return std::nullopt;
+  }
+  Vectors v;
+  v.starts = start_points(job);
+  v.keys = start_keys;
+  v.ends.resize(v.starts.rows(), 2);
+  v.methods.assign(v.starts.rows(), label);
+  for (std::size_t j = 0; j < job.start_rows.size(); ++j) {
+    const double s = source.arc(job.start_rows[j]);
+    auto above = std::upper_bound(knots.begin(), knots.end(), std::make_pair(s, std::numeric_limits<double>::max()));
+    if (above == knots.end()) above = std::prev(above);
+    if (above == knots.begin()) above = std::next(above);
+    const auto below = std::prev(above);
+    const double span = above->first - below->first;
+    const double f = span > 0.0 ? std::clamp((s - below->first) / span, 0.0, 1.0) : 0.0;
+    v.ends.row(j) = target.point_at(below->second + f * (above->second - below->second)).transpose();
+  }
+  return v;
+}
+
+// The start points of a job, for messages: how many and between which points.
+std::string job_place(const Job& job) {
+  const Points2 starts = start_points(job);
+  auto at = [](const Points2& p, Index i) {
+    return "(" + std::to_string(p(i, 0)) + ", " + std::to_string(p(i, 1)) + ")";
+  };
+  return std::to_string(starts.rows()) + " start points of c1 from " + at(starts, 0) + " to " +
+         at(starts, starts.rows() - 1);
+}
+
+}  // namespace
+
+// The default, on each job: the crossing-free, complete candidate of lowest QM. First the ones
+// that cost milliseconds: normal mapping, the order-preserving optimal matching, minimal distance
+// and reverse minimal distance carried onto the start points. Where none of them qualifies with
+// QM <= kGoodEnough, also the ones that solve a diffusion problem (tenths of a second): diffusion
+// and reverse diffusion carried onto the start points. Where none qualifies, GeometryError. Every
+// candidate maps the job's own start points, so the field has one vector per start point of C1,
+// in its order. Why not the paper's Algorithm 1: its reverse diffusion maps from C2's points, and
+// its straight vectors cross where the streamlines fan into a lobe (bench/README.md, "Real 2D
+// outlines").
+Vectors default_choice(const Job& job, const std::vector<double>& start_keys, const ArcCurve& whole_source,
+                       const CurveIndex& whole_source_index, const Settings& settings) {
+  if (job.start_rows.empty()) return forward(MapMethod::normal, job, start_keys, settings);
+  std::string why;
+  auto note = [&](const std::string& name, const std::string& what) {
+    why += (why.empty() ? "" : "; ") + name + ": " + what;
+  };
+  // One candidate: (name, the vectors or none); a failure is noted and ranks nowhere.
+  auto attempt = [&](const std::string& name, auto make) -> Scored {
+    Scored failed;
+    failed.failure = "failed";
+    try {
+      std::optional<Vectors> v = make();
+      if (!v) {
+        note(name, "does not keep the order");
+        return failed;
+      }
+      Scored s = measured(job, std::move(*v));
+      if (!s.failure.empty()) note(name, s.failure);
+      return s;
+    } catch (const GeometryError& error) {
+      note(name, error.what());
+    } catch (const InvalidInput& error) {  // a piece whose region is not what diffusion needs
+      note(name, error.what());
+    }
+    return failed;
+  };
+  auto plain = [&](MapMethod method) {
+    return [&, method]() -> std::optional<Vectors> { return forward(method, job, start_keys, settings); };
+  };
+  auto backwards = [&](MapMethod method) {
+    return [&, method]() -> std::optional<Vectors> {
+      return carried(reverse(method, job, whole_source, whole_source_index, settings), job, start_keys,
+                     reversed(basic_method(method)));
+    };
+  };
+  Scored best;
+  best.failure = "none";
+  auto consider = [&](Scored s) {
+    if (s.failure.empty() && (!best.failure.empty() || s.qm < best.qm)) best = std::move(s);
+  };
+  consider(attempt("normal", plain(MapMethod::normal)));
+  consider(attempt("optimal", plain(MapMethod::optimal)));
+  consider(attempt("minimal_distance", plain(MapMethod::minimal_distance)));
+  consider(attempt("reverse_minimal_distance", backwards(MapMethod::minimal_distance)));
+  if (!best.failure.empty() || !(best.qm <= kGoodEnough)) {
+    consider(attempt("diffusion", plain(MapMethod::diffusion)));
+    consider(attempt("reverse_diffusion", backwards(MapMethod::diffusion)));
+  }
+  if (!best.failure.empty()) {
+    throw GeometryError("map_curves: no crossing-free complete field for " + job_place(job) + " (" + why +
+                        "); try method='best', or map the other way round (reverse=True)");
+  }
+  return std::move(best.vectors);
+}
+
+}  // namespace morphomap::detail

@@ -1,0 +1,89 @@
+"""The default on real outlines segmented by others: the mouse limb bud, hour by hour
+(../shared/cases/limb-bud/2d, read its README). The default returns every start point of C1, each
+vector valid, and no crossings, closed and open, on every consecutive, 4 h and 8 h pair and on the
+long jumps; the paper's Algorithm 1 stays available.
+"""
+
+import os
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import morphomap as mm
+
+LIMB = Path(__file__).resolve().parents[1].parent / "shared" / "cases" / "limb-bud" / "2d"
+HOURS = range(248, 382)
+
+
+def require_cases():
+    if LIMB.is_dir():
+        return
+    if os.environ.get("CI", "").lower() == "true":
+        pytest.fail(f"the real cases are missing ({LIMB.name}); CI must run these tests")
+    pytest.skip("the shared real cases are not beside the project")
+
+
+def outline(hour):
+    return np.loadtxt(LIMB / f"limb_h{hour}.csv", delimiter=",", skiprows=1)
+
+
+def pairs():
+    out = [(h, h + 1) for h in range(248, 381)]
+    out += [(h, h + 4) for h in range(248, 378, 4)] + [(h, h + 8) for h in range(248, 374, 8)]
+    return out + [(250, 270), (330, 381)]
+
+
+def check_default(c1, c2, closed):
+    """The default's contract: C1's points each once, in order, valid, no crossings. The glitch
+    outlines (a first point across the closing segment) are made simple first, as map_curves
+    does itself with a warning (tests/test_make_simple.py), so that they are measured on the
+    curves that were mapped."""
+    c1, c2 = mm.make_simple(c1, closed=closed)[0], mm.make_simple(c2, closed=closed)[0]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # nothing left to repair
+        field = mm.map_curves(c1, c2, closed=closed)
+    q = mm.quality(field, c1, c2, closed=closed)
+    assert field.valid.all()
+    assert q.crossings == 0
+    size = np.ptp(np.vstack([c1, c2]), axis=0).max()
+    # Every point of C1 is a start point (a split point is one of its own), in the order along C1.
+    assert mm.closest_points(c1, field.starts, closed=closed).distances.max() < 1e-12 * size
+    assert mm.closest_points(field.ends, c2, closed=closed).distances.max() < 1e-9 * size
+    return field, q
+
+
+@pytest.mark.parametrize("closed", [True, False], ids=["closed", "open"])
+def test_default_is_crossing_free_and_complete_on_every_pair(closed):
+    require_cases()
+    failures = []
+    curves = {h: outline(h) for h in HOURS}
+    for a, b in pairs():
+        try:
+            check_default(curves[a], curves[b], closed)
+        except (AssertionError, ValueError, RuntimeError) as error:
+            failures.append(f"{a}->{b}: {str(error).splitlines()[0][:200]}")
+    assert not failures, f"{len(failures)} of {len(pairs())} pairs: " + "; ".join(failures[:10])
+
+
+@pytest.mark.parametrize("closed", [True, False], ids=["closed", "open"])
+def test_the_lobed_jump_the_paper_crosses_on(closed):
+    # 330 h -> 381 h: digit lobes appear. The paper's Algorithm 1 gives reverse diffusion vectors
+    # that cross where the streamlines fan into a lobe; the default does not.
+    require_cases()
+    c1, c2 = outline(330), outline(381)
+    paper = mm.map_curves(c1, c2, "paper", closed=closed)
+    assert mm.quality(paper, c1, c2, closed=closed).crossings > 0
+    field, q = check_default(c1, c2, closed)
+    assert len(field.starts) >= len(c1)
+    assert q.qm < 1.0
+
+
+def test_paper_is_algorithm_1_as_stated():
+    # Normal mapping wherever it has no crossings or misses, reverse diffusion elsewhere.
+    c1, c2 = mm.load_example("circle_ellipse")
+    paper = mm.map_curves(c1, c2, "paper")
+    assert set(paper.method.tolist()) == {"normal"}
+    normal = mm.map_curves(c1, c2, "normal")
+    np.testing.assert_array_equal(paper.ends, normal.ends)
