@@ -16,6 +16,7 @@ import pytest
 import trimesh
 
 import morphomap as mm
+import morphomap.io.fenicsx
 from conftest import circle, require_client
 
 A2, B2 = np.array([[1.2, 0.3], [-0.1, 0.9]]), np.array([0.3, -0.2])
@@ -90,7 +91,15 @@ def test_writes_are_atomic(tmp_path, monkeypatch):
     def broken(*args, **kwargs):
         raise OSError("disk full")
 
+    mm.write_interior(tmp_path / "u.vtu", interior)
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
     monkeypatch.setattr(meshio, "write", broken)
+    with pytest.raises(OSError, match="disk full"):
+        mm.write_interior(tmp_path / "u.vtu", interior)
+    # XDMF: the .h5 written, then the XML fails: neither file is replaced.
+    import xml.etree.ElementTree as ElementTree
+
+    monkeypatch.setattr(ElementTree, "tostring", broken)
     with pytest.raises(OSError, match="disk full"):
         mm.write_interior(tmp_path / "u.xdmf", interior)
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
@@ -98,44 +107,95 @@ def test_writes_are_atomic(tmp_path, monkeypatch):
         mm.write_interior(tmp_path / "u.stl", interior)
 
 
+# The system Python has dolfinx but not morphomap's other dependencies: the client loads the
+# dolfinx helper by its file, which imports only numpy, h5py and dolfinx.
+LOAD_HELPER = f"""
+import importlib.util
+spec = importlib.util.spec_from_file_location("fenicsx_helper", {morphomap.io.fenicsx.__file__!r})
+helper = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(helper)
+"""
+
+
 def test_fenicsx_reads_the_mesh_and_the_displacement(tmp_path):
-    # FEniCSx reads the mesh, the displacement goes into a P1 vector function by the nodes' input
-    # indices, and dolfinx integrates div u over the domain: (trace A - 2) times the area for an
-    # affine map; the nodal values are the affine map's at dolfinx's own coordinates.
+    # FEniCSx reads the mesh with its default call, the helper gives the displacement as a P1
+    # vector function, and dolfinx integrates div u over the domain: (trace A - 2) times the area
+    # for an affine map; the nodal values are the affine map's at dolfinx's own coordinates.
     require_client(dolfinx_available(), "FEniCSx (python3-dolfinx, python3-h5py)")
     _, interior = affine_interior()
-    mm.write_interior(tmp_path / "u.xdmf", interior)
-    got = run_client([SYSTEM_PYTHON], """
-        import json
-        import h5py
-        import numpy as np
-        import ufl
-        from dolfinx import fem, io
-        from mpi4py import MPI
+    mm.write_interior(tmp_path / "u.xdmf", interior, dt=0.5)
+    got = run_client([SYSTEM_PYTHON], LOAD_HELPER + """
+import json
+import numpy as np
+import ufl
+from dolfinx import fem, io
+from mpi4py import MPI
 
-        with io.XDMFFile(MPI.COMM_WORLD, "u.xdmf", "r") as xdmf:
-            mesh = xdmf.read_mesh(name="Grid")
-        import xml.etree.ElementTree as ElementTree
-
-        # The displacement's dataset, as the XDMF file names it.
-        item = ElementTree.parse("u.xdmf").find(".//Attribute[@Name='displacement']/DataItem").text
-        file, dataset = item.strip().split(":")
-        with h5py.File(file, "r") as h5:
-            displacement = h5[dataset][...]
-        V = fem.VectorFunctionSpace(mesh, ("CG", 1))
-        u = fem.Function(V)
-        # P1 on a P1 geometry: dof i sits at geometry node i, whose input index says which row it is.
-        original = mesh.geometry.input_global_indices
-        u.x.array[:] = displacement[original].ravel()
-        area = fem.assemble_scalar(fem.form(fem.Constant(mesh, 1.0) * ufl.dx))
-        divergence = fem.assemble_scalar(fem.form(ufl.div(u) * ufl.dx))
-        print(json.dumps({"nodes": mesh.geometry.x.shape[0], "area": area, "divergence": divergence,
-                          "x": mesh.geometry.x[:, :2].tolist(), "u": u.x.array.reshape(-1, 2).tolist()}))
-    """, tmp_path)
-    assert got["nodes"] == len(interior.points)
+with io.XDMFFile(MPI.COMM_WORLD, "u.xdmf", "r") as xdmf:
+    mesh = xdmf.read_mesh()
+u = helper.read_function("u.xdmf", mesh=mesh)
+v = helper.read_function("u.xdmf", "velocity")
+area = fem.assemble_scalar(fem.form(fem.Constant(mesh, 1.0) * ufl.dx))
+divergence = fem.assemble_scalar(fem.form(ufl.div(u) * ufl.dx))
+x = u.function_space.tabulate_dof_coordinates()[:, :2]
+print(json.dumps({"nodes": mesh.geometry.x.shape[0], "gdim": mesh.geometry.dim, "area": area,
+                  "divergence": divergence, "x": x.tolist(), "u": u.x.array.reshape(-1, 2).tolist(),
+                  "v": v.x.array.reshape(-1, 2).tolist()}))
+""", tmp_path)
+    assert got["nodes"] == len(interior.points) and got["gdim"] == 2
     x, u = np.array(got["x"]), np.array(got["u"])
     assert np.abs(u - (x @ A2.T + B2 - x)).max() < 1e-10
+    assert np.abs(np.array(got["v"]) - u / 0.5).max() < 1e-10
     assert got["divergence"] == pytest.approx((np.trace(A2) - 2) * got["area"], rel=1e-10)
+
+
+def test_fenicsx_reads_fields_3d_interiors_and_series_with_defaults(tmp_path):
+    # Every XDMF kind opens with read_mesh() and no name: a 3D boundary field (triangles; a 2D
+    # one is points, which dolfinx makes no mesh of), a 3D interior (tetrahedra), and a series
+    # on one moving mesh, each step by its time value.
+    require_client(dolfinx_available(), "FEniCSx (python3-dolfinx, python3-h5py)")
+    field, interior = affine_interior()
+    s1 = trimesh.creation.icosphere(2)
+    field3 = mm.map_surfaces(s1, s1.copy().apply_scale(1.3), "normal")
+    mm.write_field(tmp_path / "f.xdmf", field3)
+    interior3 = mm.extend_field(field3, mesh_size=0.3)
+    mm.write_interior(tmp_path / "u3.xdmf", interior3)
+    steps = [interior, mm.extend_field(field, mesh=(interior.points, interior.cells), substeps=2)]
+    mm.io.write_interior_series(tmp_path / "series.xdmf", steps, [0.0, 0.25])
+    got = run_client([SYSTEM_PYTHON], LOAD_HELPER + """
+import json
+from dolfinx import io
+from mpi4py import MPI
+
+out = {}
+for name in ("f.xdmf", "u3.xdmf", "series.xdmf"):
+    with io.XDMFFile(MPI.COMM_WORLD, name, "r") as xdmf:
+        mesh = xdmf.read_mesh()
+    out[name] = {"nodes": mesh.geometry.x.shape[0], "cells": mesh.topology.index_map(mesh.topology.dim).size_local}
+    if name != "f.xdmf":
+        times = (0.0, 0.25) if name == "series.xdmf" else (None,)
+        for time in times:
+            u = helper.read_function(name, mesh=mesh, time=time)
+            values = u.x.array.reshape(-1, mesh.geometry.dim)
+            out[name][str(time)] = {"u": values.tolist(), "dof_x": u.function_space.tabulate_dof_coordinates().tolist()}
+try:
+    helper.read_function("series.xdmf", time=0.3)
+except ValueError as error:
+    out["wrong time"] = str(error)
+print(json.dumps(out))
+""", tmp_path)
+    assert got["f.xdmf"]["nodes"] == len(field3) and got["f.xdmf"]["cells"] == len(field3.faces)
+    assert got["u3.xdmf"]["nodes"] == len(interior3.points) and got["u3.xdmf"]["cells"] == len(interior3.cells)
+    for name, time, expected in (("u3.xdmf", None, interior3), ("series.xdmf", 0.0, steps[0]),
+                                 ("series.xdmf", 0.25, steps[1])):
+        read = got[name][str(time)]
+        dim = expected.dim
+        # Each dof's value is the displacement of the node of `expected` at the dof's position.
+        positions = np.array(read["dof_x"])[:, :dim]
+        nearest = np.argmin(((positions[:, None, :] - expected.points[None, :, :]) ** 2).sum(axis=2), axis=1)
+        assert np.abs(positions - expected.points[nearest]).max() < 1e-12
+        assert np.abs(np.array(read["u"]) - expected.displacement[nearest]).max() < 1e-12
+    assert "time: 0.3 is not a time of series.xdmf: use one of 0, 0.25" in got["wrong time"]
 
 
 def test_paraview_reads_the_arrays(tmp_path):

@@ -123,12 +123,9 @@ def write_curve(path, points, *, header=True) -> None:
             handle.write(f"{x!r},{y!r}\n")
 
 
-def write_field(path, field: DisplacementField, *, dt=None) -> None:
-    """Write a displacement field; the format from the suffix: ``.csv`` (below), ``.vtu``, ``.vtp``
-    (needs the optional ``vtk`` package), ``.xdmf`` or a COMSOL ``.txt`` table
-    (:mod:`morphomap.io.solver`; ``dt`` adds the velocity there).
-
-    CSV: ``start_x,start_y,end_x,end_y,valid,method`` per vector.
+def write_field_csv(path, field: DisplacementField) -> None:
+    """Write a displacement field as CSV: ``start_x,start_y,end_x,end_y,valid,method`` per vector
+    (:func:`morphomap.write_field` picks this writer for ``.csv`` and open files).
 
     Missing coordinates are written as ``nan``; ``valid`` is 1 or 0. 3D fields get ``start_z`` and
     ``end_z`` columns, and their faces follow as a second table (``face_a,face_b,face_c``), so that
@@ -137,13 +134,6 @@ def write_field(path, field: DisplacementField, *, dt=None) -> None:
     """
     if not isinstance(field, DisplacementField):
         raise TypeError(f"field: expected a DisplacementField, got {type(field).__name__}")
-    if not hasattr(path, "write"):
-        from .solver import FIELD_SUFFIXES, write_field_for_solver
-
-        suffix = os.path.splitext(os.fspath(path))[1].lower()
-        if suffix in FIELD_SUFFIXES:
-            write_field_for_solver(path, field, dt)
-            return
     header = _FIELD_2D if field.dim == 2 else _FIELD_3D
     with _output(path) as handle:
         handle.write(",".join(header) + "\n")
@@ -159,7 +149,7 @@ def write_field(path, field: DisplacementField, *, dt=None) -> None:
 
 
 def read_field(path) -> DisplacementField:
-    """Read a displacement field written by :func:`write_field`.
+    """Read a displacement field written by :func:`write_field_csv`.
 
     The header is required; columns may come in any order. ``valid`` is recomputed from the
     coordinates (a row is valid when none of them is NaN), so the column is only checked.
