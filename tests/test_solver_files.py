@@ -281,3 +281,76 @@ def test_vtp_boundary_fields_open_in_vtk_and_paraview(tmp_path):
     assert np.allclose(np.array(got["f.vtp"]["velocity"])[:, :2], field.vectors / 0.5)
     assert got["f.vtp"]["valid"] == [1] * len(field)
     assert np.allclose(np.array(got["f3.vtp"]["displacement"]), field3.vectors)
+
+
+def paraview_command():
+    """pvpython, under a virtual X server where there is no display (ParaView's Debian build
+    renders offscreen through X)."""
+    require_client(shutil.which("pvpython") is not None, "ParaView (pvpython, python3-paraview)")
+    if os.environ.get("DISPLAY"):
+        return ["pvpython"]
+    require_client(shutil.which("xvfb-run") is not None, "a virtual X server for offscreen rendering (xvfb, xauth)")
+    return ["xvfb-run", "-a", "-s", "-screen 0 640x480x24", "pvpython"]
+
+
+def test_paraview_warps_and_renders_every_file_kind(tmp_path):
+    # Each file opened as File > Open does (OpenDataFile picks the reader), warped by its
+    # displacement and rendered to a PNG; the PNG shows the mesh, not only the background.
+    import matplotlib.image
+
+    command = paraview_command()
+    field, interior = affine_interior()
+    s1 = trimesh.creation.icosphere(2)
+    field3 = mm.map_surfaces(s1, s1.copy().apply_scale(1.3), "normal")
+    interior3 = mm.extend_field(field3, mesh_size=0.3)
+    steps = [interior, mm.extend_field(field, mesh=(interior.points, interior.cells), substeps=2)]
+    written = {"u.vtu": lambda p: mm.write_interior(p, interior, dt=0.5),
+               "u.xdmf": lambda p: mm.write_interior(p, interior, dt=0.5),
+               "u3.xdmf": lambda p: mm.write_interior(p, interior3),
+               "f.vtu": lambda p: mm.write_field(p, field),
+               "f.xdmf": lambda p: mm.write_field(p, field),
+               "f3.vtu": lambda p: mm.write_field(p, field3),
+               "f3.xdmf": lambda p: mm.write_field(p, field3),
+               "series.xdmf": lambda p: mm.io.write_interior_series(p, steps, [0.0, 0.25]),
+               "series.pvd": lambda p: mm.io.write_interior_series(p, steps, [0.0, 0.25])}
+    for name, write in written.items():
+        write(tmp_path / name)
+    got = run_client(command, f"""
+        import json
+        from paraview import servermanager
+        from paraview.simple import (GetActiveViewOrCreate, OpenDataFile, ResetCamera, SaveScreenshot, Show,
+                                     UpdatePipeline, WarpByVector)
+
+        out = {{}}
+        view = GetActiveViewOrCreate("RenderView")
+        for name in {list(written)!r}:
+            # The full path, as File > Open gives it (Debian's Xdmf3 readers misjoin a bare name).
+            source = OpenDataFile({str(tmp_path)!r} + "/" + name)
+            times = list(source.TimestepValues or [])
+            source.UpdatePipeline(times[-1] if times else 0.0)
+            arrays = source.PointData
+            warp = WarpByVector(Input=source, Vectors=["POINTS", "displacement"])
+            warp.UpdatePipeline(times[-1] if times else 0.0)
+            components = arrays["displacement"].GetNumberOfComponents()
+            method = sorted(arrays.keys())
+            display = Show(warp, view)
+            display.PointSize = 4  # a 2D boundary field is points
+            ResetCamera(view)
+            SaveScreenshot(name + ".png", view, ImageResolution=[320, 240])
+            display.Visibility = 0
+            out[name] = {{"reader": source.GetXMLName(), "times": times, "components": components,
+                         "arrays": method, "bounds": warp.GetDataInformation().GetBounds()}}
+        print(json.dumps(out))
+    """, tmp_path)
+    for name in written:
+        assert got[name]["components"] == 3, name  # Warp By Vector's assertion
+        image = matplotlib.image.imread(tmp_path / f"{name}.png")[..., :3]
+        background = image[0, 0]
+        drawn = np.abs(image - background).max(axis=2) > 0.05
+        assert drawn.mean() > 0.01, f"{name}: {drawn.mean():.4f} of the pixels drawn"
+    assert got["series.pvd"]["times"] == [0.0, 0.25] and got["series.xdmf"]["times"] == [0.0, 0.25]
+    assert "method" in got["f.vtu"]["arrays"] and "velocity" in got["u.xdmf"]["arrays"]
+    # Warped by the affine map's displacement: x reaches b_x + |A's first row| on the image of the
+    # unit circle (its inscribed polygon a little less).
+    for name in ("u.vtu", "u.xdmf", "f.vtu"):
+        assert B2[0] + 0.99 * np.linalg.norm(A2[0]) < got[name]["bounds"][1] <= B2[0] + np.linalg.norm(A2[0]) + 1e-9

@@ -103,7 +103,9 @@ def write_xdmf(path, frames, times=None) -> None:
     root = ElementTree.Element("Xdmf", Version="3.0")
     domain = ElementTree.SubElement(root, "Domain")
     with h5py.File(os.path.join(os.path.dirname(path), h5_name), "w") as h5:
-        first_time = None if times is None else times[0]
+        # In a series the times are the collection's: a Time on the grid 'mesh' as well makes
+        # ParaView's Xdmf3 reader draw nothing at that time.
+        first_time = times[0] if times is not None and len(frames) == 1 else None
         _grid(domain, h5, h5_name, frames[0], "mesh", "/mesh", first_time, None)
         if len(frames) > 1:
             series = ElementTree.SubElement(domain, "Grid", Name="series", GridType="Collection",
