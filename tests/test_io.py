@@ -157,3 +157,66 @@ def test_kidney_example_defeats_plain_normal_mapping():
     field = mm.map_curves(c1, c2, "normal", split=True)
     assert mm.count_crossings(field.starts, field.ends) > 0
     assert math.isfinite(mm.quality(field, c1, c2).qm)
+
+
+def test_an_unknown_suffix_is_refused_with_the_known_ones(tmp_path):
+    c1 = circle(40)
+    field = mm.DisplacementField(c1, 1.5 * c1, "normal", source=c1)
+    with pytest.raises(ValueError, match=r"path: unknown format '\.vtk' for a displacement field: use one of "
+                                         r"\.csv \(.*\); \.txt \(.*\); \.vtu \(.*\); \.vtp \(.*\); \.xdmf \("):
+        mm.write_field(tmp_path / "x.vtk", field)
+    interior = mm.extend_field(field, mesh_size=0.3)
+    with pytest.raises(ValueError, match=r"unknown format '\.csv' for an interior field: use one of \.txt .*\.vtu"):
+        mm.write_interior(tmp_path / "u.csv", interior)
+    with pytest.raises(ValueError, match=r"unknown format '\.vtu' for a series of interior fields: use one of "
+                                         r"\.xdmf .*\.pvd"):
+        mm.io.write_interior_series(tmp_path / "s.vtu", [interior], [0.0])
+    with pytest.raises(ValueError, match="unknown format '\\(no suffix\\)'"):
+        mm.write_field(tmp_path / "field", field)
+    assert list(tmp_path.iterdir()) == []  # nothing written
+    assert set(mm.io.FORMATS) == {".csv", ".txt", ".vtu", ".vtp", ".xdmf", ".pvd"}
+
+
+def test_comsol_tables_carry_the_velocity_when_dt_is_given(tmp_path):
+    c1 = circle(40)
+    field = mm.DisplacementField(c1, 1.5 * c1, "normal", source=c1)
+    interior = mm.extend_field(field, mesh_size=0.3)
+    mm.write_field(tmp_path / "f.txt", field, dt=0.5)
+    mm.write_interior(tmp_path / "u.txt", interior, dt=0.5)
+    for name, points, displacement in (("f.txt", field.starts, field.vectors),
+                                       ("u.txt", interior.points, interior.displacement)):
+        lines = (tmp_path / name).read_text().splitlines()
+        assert lines[1] == "% x y ux uy vx vy" and "displacement, velocity" in lines[0]
+        table = np.loadtxt(tmp_path / name, comments="%")
+        assert np.array_equal(table[:, :2], points) and np.array_equal(table[:, 2:4], displacement)
+        assert np.allclose(table[:, 4:], displacement / 0.5, rtol=0, atol=1e-15)
+    mm.write_interior(tmp_path / "plain.txt", interior)
+    assert (tmp_path / "plain.txt").read_text().splitlines()[1] == "% x y ux uy"
+
+
+def test_series_files_hold_every_step_at_its_time(tmp_path):
+    import xml.etree.ElementTree as ElementTree
+
+    import meshio
+
+    c1 = circle(40)
+    field = mm.DisplacementField(c1, 1.5 * c1, "normal", source=c1)
+    first = mm.extend_field(field, mesh_size=0.3)
+    steps = [first, mm.extend_field(field, mesh=(first.points, first.cells), substeps=3)]
+    mm.io.write_interior_series(tmp_path / "s.pvd", steps, [1.0, 2.5])
+    entries = ElementTree.parse(tmp_path / "s.pvd").getroot().findall("./Collection/DataSet")
+    assert [(e.get("timestep"), e.get("file")) for e in entries] == [("1.0", "s_0000.vtu"), ("2.5", "s_0001.vtu")]
+    for entry, step in zip(entries, steps):
+        back = meshio.read(tmp_path / entry.get("file"))
+        assert np.allclose(back.point_data["displacement"][:, :2], step.displacement)
+        assert np.allclose(back.point_data["displacement"][:, 2], 0)
+    from morphomap.io.fenicsx import read_point_data
+
+    mm.io.write_interior_series(tmp_path / "s.xdmf", steps, [1.0, 2.5])
+    assert np.array_equal(read_point_data(tmp_path / "s.xdmf", time=2.5)[:, :2], steps[1].displacement)
+    assert np.array_equal(read_point_data(tmp_path / "s.xdmf")[:, :2], steps[0].displacement)
+    other = mm.extend_field(field, mesh_size=0.2)
+    with pytest.raises(ValueError, match="interiors: step 1 has other cells than step 0.*write a .pvd"):
+        mm.io.write_interior_series(tmp_path / "t.xdmf", [first, other], [0.0, 1.0])
+    with pytest.raises(ValueError, match="times: expected 2 increasing values"):
+        mm.io.write_interior_series(tmp_path / "t.pvd", steps, [1.0, 1.0])
