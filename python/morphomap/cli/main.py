@@ -112,7 +112,12 @@ def _map(args, parser) -> int:
 
 def _extend(args, parser) -> int:
     import morphomap
+    from ..io.formats import writer
 
+    try:
+        writer(args.output, "interior")  # an unknown suffix before the work, not after it
+    except ValueError as error:
+        parser.error(f"-o {args.output}: {error}")
     _, _, _, field, q = _read_and_map(args, parser)
     mesh = None
     if args.mesh:
@@ -136,8 +141,10 @@ def _extend(args, parser) -> int:
         morphomap.write_interior(args.output, interior, dt=args.dt)
     except OSError as error:
         parser.error(f"cannot write {error.filename}: {error.strerror or error}")
-    print(f"{_summary(field, q)}; {interior!r}, boundary nodes within {interior.boundary_distance:.3g} of C1; "
-          f"written to {args.output}", file=sys.stderr)
+    tried = ", ".join(f"{s} substep{'s' if s > 1 else ''}{' + untangle' if u else ''}: "
+                      f"{'no solution' if n is None else f'{n} inverted'}" for s, u, n, _ in interior.attempts)
+    print(f"{_summary(field, q)}; {interior!r} (tried {tried}), boundary nodes within "
+          f"{interior.boundary_distance:.3g} of C1; written to {args.output}", file=sys.stderr)
     return 0
 
 
@@ -339,10 +346,13 @@ def main(argv=None) -> int:
                         help="the interior problem: a vector Laplace equation or linear elasticity")
     extend.add_argument("--poisson-ratio", type=float, default=0.3, metavar="NU",
                         help="--extension elastic: the Poisson ratio, 0 <= NU < 0.5 (default 0.3)")
-    extend.add_argument("--substeps", type=int, default=1, metavar="K",
-                        help="move the mesh in K steps, each solved on the moved mesh (fewer inverted cells)")
-    extend.add_argument("--untangle", action="store_true",
-                        help="then move the inner corners of the cells still inverted to untangle them")
+    extend.add_argument("--substeps", type=int, default=None, metavar="K",
+                        help="move the mesh in K steps, each solved on the moved mesh (default: as many as "
+                             "leave no cell inverted)")
+    extend.add_argument("--untangle", action=argparse.BooleanOptionalAction, default=None,
+                        help="then move the inner corners of the cells still inverted to untangle them (default: "
+                             "where substeps leave inverted cells); with both --substeps and --[no-]untangle "
+                             "the field is written as solved, inverted cells counted")
     extend.add_argument("--dt", type=lambda text: _length(text, positive=True), default=None, metavar="DT",
                         help="the time between the frames: also write the velocity")
     extend.add_argument("-o", "--output", required=True, metavar="U.xdmf",
