@@ -42,6 +42,14 @@ def _grid(root, path, time):
     return grid
 
 
+def read_times(path) -> list:
+    """The ``Time`` values of a series file, in order (empty for a file without times)."""
+    root = ElementTree.parse(os.fspath(path)).getroot()
+    series = root.find("./Domain/Grid[@CollectionType='Temporal']")
+    grids = series.findall("Grid") if series is not None else root.findall("./Domain/Grid")
+    return [float(g.find("Time").get("Value")) for g in grids if g.find("Time") is not None]
+
+
 def read_point_data(path, name="displacement", *, time=None):
     """Point data ``name`` of a morphomap XDMF file as numpy: ``(P, 3)`` vectors or ``(P,)``, in the
     file's node order (without dolfinx). ``time``: a step of a series (default: the grid ``mesh``)."""
