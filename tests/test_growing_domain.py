@@ -17,7 +17,8 @@ def test_mass_is_conserved_and_no_triangle_inverts():
     assert result["concentration"].max() < 0.9
 
 
-def test_eq2_in_dolfinx_keeps_the_mass_across_the_frames(tmp_path):
+@pytest.mark.parametrize("dim", [2, 3])
+def test_eq2_in_dolfinx_keeps_the_mass_across_the_frames(tmp_path, dim):
     # morphomap makes the motion (frames mapped, extended on one moving mesh, a series XDMF);
     # dolfinx, in the system Python, solves Eq. 2 on the mesh it reads with its defaults.
     import json
@@ -33,7 +34,7 @@ def test_eq2_in_dolfinx_keeps_the_mass_across_the_frames(tmp_path):
     available = os.path.exists(python) and subprocess.run(
         [python, "-c", "import dolfinx, h5py, matplotlib"], capture_output=True).returncode == 0
     require_client(available, "FEniCSx (python3-dolfinx, python3-h5py) with matplotlib")
-    interiors = growing_frames.prepare(tmp_path)
+    interiors = growing_frames.prepare(tmp_path, dim=dim)
     assert len(interiors) == 4 and all(i.inverted == 0 for i in interiors)
     done = subprocess.run([python, growing_domain_fenicsx.__file__, str(tmp_path)], capture_output=True, text=True,
                           timeout=600, cwd=tmp_path)
@@ -43,5 +44,5 @@ def test_eq2_in_dolfinx_keeps_the_mass_across_the_frames(tmp_path):
     assert got["drift"] < 1e-10 and got["masses"][0] > 0
     assert got["peak"] < 0.9  # the blob spread out on the growing domain
     image = matplotlib.image.imread(tmp_path / "concentration.png")[..., :3]
-    assert (np.abs(image - image[0, 0]).max(axis=2) > 0.05).mean() > 0.1
+    assert (np.abs(image - image[0, 0]).max(axis=2) > 0.05).mean() > 0.05
     assert (tmp_path / "concentration.xdmf").exists() and (tmp_path / "concentration.h5").exists()

@@ -39,9 +39,9 @@ def _helper():
     return module
 
 
-def solve(folder, diffusivity: float = 0.01, substeps: int = 10, centre=(1.0, 0.5), width: float = 0.3):
-    """Solve Eq. 2 through the steps of ``folder/motion.xdmf``; returns a dict of the masses
-    (one per substep and the start), the final concentration and node positions."""
+def solve(folder, diffusivity: float = 0.01, substeps: int = 10, centre=(1.0, 0.5, 0.0), width: float = 0.3):
+    """Solve Eq. 2 through the steps of ``folder/motion.xdmf`` (2D or 3D); returns a dict of the
+    masses (one per substep and the start), the mesh and the final concentration."""
     import ufl
     from dolfinx import fem, io
     from dolfinx.fem.petsc import assemble_matrix
@@ -58,7 +58,7 @@ def solve(folder, diffusivity: float = 0.01, substeps: int = 10, centre=(1.0, 0.
     nodes = np.asarray(mesh.geometry.input_global_indices)
     space = fem.FunctionSpace(mesh, ("Lagrange", 1))
     c = fem.Function(space, name="c")
-    c.interpolate(lambda x: np.exp(-((x[0] - centre[0]) ** 2 + (x[1] - centre[1]) ** 2) / width ** 2))
+    c.interpolate(lambda x: np.exp(-sum((x[i] - centre[i]) ** 2 for i in range(len(centre))) / width ** 2))
     u, v = ufl.TrialFunction(space), ufl.TestFunction(space)
     dt = dt_step / substeps
     mass_form = fem.form(u * v * ufl.dx)
@@ -95,21 +95,27 @@ def solve(folder, diffusivity: float = 0.01, substeps: int = 10, centre=(1.0, 0.
 
 
 def plot(result, path):
-    """The concentration on the last frame, on the moved mesh (2D)."""
+    """The concentration on the last frame, on the moved mesh (3D: the tetrahedra's corners
+    within a thin slab about z = 0)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     mesh, c = result["mesh"], result["c"]
-    corners = np.asarray(getattr(mesh.geometry.dofmap, "array", mesh.geometry.dofmap)).reshape(-1, 3)
-    dofs = np.asarray(getattr(c.function_space.dofmap.list, "array", c.function_space.dofmap.list)).reshape(-1, 3)
+    width = mesh.topology.dim + 1
+    corners = np.asarray(getattr(mesh.geometry.dofmap, "array", mesh.geometry.dofmap)).reshape(-1, width)
+    dofs = np.asarray(getattr(c.function_space.dofmap.list, "array", c.function_space.dofmap.list)).reshape(-1, width)
     values = np.empty(mesh.geometry.x.shape[0])
     values[corners.ravel()] = c.x.array[dofs.ravel()]
     x = mesh.geometry.x
     figure, axes = plt.subplots(figsize=(6, 5), layout="constrained")
-    shading = axes.tripcolor(x[:, 0], x[:, 1], corners, values, shading="gouraud", cmap="viridis")
-    axes.triplot(x[:, 0], x[:, 1], corners, color="white", linewidth=0.1, alpha=0.4)
+    if width == 3:
+        shading = axes.tripcolor(x[:, 0], x[:, 1], corners, values, shading="gouraud", cmap="viridis")
+        axes.triplot(x[:, 0], x[:, 1], corners, color="white", linewidth=0.1, alpha=0.4)
+    else:
+        slab = np.abs(x[:, 2]) < 0.1
+        shading = axes.scatter(x[slab, 0], x[slab, 1], c=values[slab], s=12, cmap="viridis")
     axes.set_aspect("equal")
     axes.set_title(f"c on the last frame; total mass kept to {result['drift']:.1e}")
     figure.colorbar(shading, ax=axes, label="c")

@@ -1,9 +1,10 @@
 """The motion of a growing domain across a series of frames, for a PDE solver: one mesh, moved.
 
-    python -m morphomap.examples.growing_frames OUT
+    python -m morphomap.examples.growing_frames OUT [3d]
 
-Frames 0..4 of a growing outline with a bud (closed curves), each consecutive pair mapped
-(``map_curves``, the default method), and the boundary displacement extended into the domain on
+Frames 0..4 of a growing outline with a bud (closed curves; with ``3d`` closed surfaces), each
+consecutive pair mapped (``map_curves`` / ``map_surfaces``, the default method), and the boundary
+displacement extended into the domain on
 one mesh that moves with it: frame 0's domain meshed once, the mesh of frame k + 1 the mesh of
 frame k moved by the interior field (``extend_field``, which leaves no cell inverted). Writes
 ``OUT/motion.xdmf`` (+ ``.h5``): the mesh (grid ``mesh``, frame 0) and, per step k at time k·dt,
@@ -28,8 +29,21 @@ def frames(count: int = 5, points: int = 400):
             for k in range(count)]
 
 
-def prepare(folder, count: int = 5, mesh_size: float = 0.08, dt: float = 1.0):
-    """Map and extend the frames on one moving mesh; write ``folder/motion.xdmf``.
+def surfaces(count: int = 5, subdivisions: int = 3):
+    """``count`` closed surfaces ``(vertices (V, 3), faces (F, 3))``, the 3D form of
+    :func:`frames`: a sphere that widens while a bud grows out of it."""
+    import trimesh
+
+    sphere = trimesh.creation.icosphere(subdivisions)
+    directions = sphere.vertices / np.linalg.norm(sphere.vertices, axis=1)[:, None]
+    angle = np.arccos(np.clip(directions @ np.array([np.cos(0.5), np.sin(0.5), 0.0]), -1.0, 1.0))
+    bud = np.exp(-angle ** 2 / (2 * 0.35 ** 2))
+    return [(directions * (1 + 0.08 * k + 0.25 * k * bud)[:, None], sphere.faces) for k in range(count)]
+
+
+def prepare(folder, count: int = 5, mesh_size: float = None, dt: float = 1.0, dim: int = 2):
+    """Map and extend the frames (curves, or surfaces for ``dim=3``) on one moving mesh; write
+    ``folder/motion.xdmf``. ``mesh_size``: of the first frame's mesh (default 0.08 in 2D, 0.15 in 3D).
 
     Returns
     -------
@@ -39,11 +53,14 @@ def prepare(folder, count: int = 5, mesh_size: float = 0.08, dt: float = 1.0):
     import morphomap as mm
     from morphomap.io import write_interior_series
 
-    curves = frames(count)
+    if dim not in (2, 3):
+        raise ValueError(f"dim: expected 2 or 3, got {dim!r}")
+    shapes, mapping = (frames(count), mm.map_curves) if dim == 2 else (surfaces(count), mm.map_surfaces)
+    mesh_size = (0.08 if dim == 2 else 0.15) if mesh_size is None else mesh_size
     interiors = []
     mesh = None
     for k in range(count - 1):
-        field = mm.map_curves(curves[k], curves[k + 1])
+        field = mapping(shapes[k], shapes[k + 1])
         interior = mm.extend_field(field, mesh=mesh, mesh_size=mesh_size)
         interiors.append(interior)
         mesh = (interior.points + interior.displacement, interior.cells)
@@ -55,9 +72,9 @@ def prepare(folder, count: int = 5, mesh_size: float = 0.08, dt: float = 1.0):
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else argv
     folder = argv[0] if argv else "growing-frames"
-    interiors = prepare(folder)
+    interiors = prepare(folder, dim=3 if "3d" in argv[1:] else 2)
     print(f"{len(interiors)} steps on one mesh of {len(interiors[0].points)} nodes and {len(interiors[0].cells)} "
-          f"triangles; inverted cells per step {[i.inverted for i in interiors]}, substeps "
+          f"cells; inverted cells per step {[i.inverted for i in interiors]}, substeps "
           f"{[i.substeps for i in interiors]}; written to {os.path.join(folder, 'motion.xdmf')}")
 
 
