@@ -9,6 +9,7 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 import morphomap as mm
+from child_calls import ChildCalls
 
 AXES = np.array([2.0, 1.5, 1.2])  # the ellipsoid of the paper's Figure 12
 
@@ -558,6 +559,13 @@ def test_queries_release_the_gil(rng):
         t.join()
 
 
+@pytest.fixture(scope="module")
+def child():
+    calls = ChildCalls()
+    yield calls
+    calls.close()
+
+
 finite = st.floats(-1e3, 1e3, allow_nan=False, width=64)
 anything = st.floats(allow_nan=True, allow_infinity=True, width=64)
 
@@ -568,18 +576,16 @@ anything = st.floats(allow_nan=True, allow_infinity=True, width=64)
     faces=hnp.arrays(np.int64, st.tuples(st.integers(0, 12), st.integers(2, 4)), elements=st.integers(-2, 14)),
     queries=hnp.arrays(np.float64, st.tuples(st.integers(0, 5), st.just(3)), elements=finite),
 )
-def test_random_arrays_never_crash(vertices, faces, queries):
+def test_random_arrays_never_crash(child, vertices, faces, queries):
+    # In a child process: an abort fails this test with its input (and hypothesis shrinks it).
     for call in (
-        lambda: mm.map_surfaces((vertices, faces), (vertices, faces)),
-        lambda: mm.map_surfaces((vertices, faces), (vertices, faces), "minimal_distance"),
-        lambda: mm.SurfaceIndex(vertices, faces).closest_points(queries),
-        lambda: mm.SurfaceIndex(vertices, faces).line_intersections(queries, queries + 1),
-        lambda: mm.surface_normals(vertices, faces),
+        "mm.map_surfaces((vertices, faces), (vertices, faces))",
+        "mm.map_surfaces((vertices, faces), (vertices, faces), 'minimal_distance')",
+        "mm.SurfaceIndex(vertices, faces).closest_points(queries)",
+        "mm.SurfaceIndex(vertices, faces).line_intersections(queries, queries + 1)",
+        "mm.surface_normals(vertices, faces)",
     ):
-        try:
-            call()
-        except (ValueError, TypeError):
-            pass
+        child.run(call, "(ValueError, TypeError)", vertices=vertices, faces=faces, queries=queries)
 
 
 @st.composite
@@ -637,6 +643,31 @@ def test_lines_and_queries_from_beyond_float_range_of_a_tiny_surface():
     with pytest.raises(ValueError, match="^queries: row 0 lies more than 1e30 times"):
         index.closest_points(origins[:1])
     np.testing.assert_array_equal(index.closest_points([[0.0, 0.0, -3e-100]]).points, [[0.0, 0.0, -1e-100]])
+
+
+def test_line_origins_beyond_embree_ray_range_do_not_abort(child):
+    # A ray whose origin lies beyond Embree's limit (1.844e18 unit-box lengths) fails its
+    # ray.valid() assertion, which aborts the process (Debian's Embree keeps assertions): such lines
+    # must go to the double test. In a child process, so that an abort fails this test with its input.
+    line = "mm.SurfaceIndex(vertices, faces).line_intersections(origins, directions)"
+    # Input of test_random_arrays_never_crash's kind: one point (no extent, so no scaling) 1e30 away.
+    vertices = np.array([[1e-300, 1e30, 5e-324]])
+    faces = np.zeros((6, 3), np.int64)
+    origins = np.array([[-490.250303868375, -1.0, 98.34505936273649],
+                        [827.8600131485025, 513.4969534877225, 1e-300],
+                        [0.0, -52.81608018327927, -183.35326721158856]])
+    hits = child.run(line, vertices=vertices, faces=faces, origins=origins, directions=origins + 1)
+    np.testing.assert_array_equal(hits.faces, [-1, -1, -1])
+    # The cube shrunk to half-widths 1e-20 and 1e-25, lines 1 away: 5e19 and 5e24 unit-box lengths
+    # (in double both squares a line crosses are 1 away, so either may win the tie).
+    v, f = cube()
+    origins = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [1.0, 1.0, 0.0]])
+    directions = np.array([[-1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, 1.0]])
+    for size in (1e-20, 1e-25):
+        hits = child.run(line, vertices=v * size, faces=f, origins=origins, directions=directions)
+        assert (abs(v[f[hits.faces[0]], 0]) == 1.0).all() and (abs(v[f[hits.faces[1]], 2]) == 1.0).all()
+        assert hits.faces[2] == -1
+        np.testing.assert_allclose(hits.distances[:2], [1.0, 1.0], rtol=1e-15)
 
 
 def octahedron():

@@ -47,9 +47,13 @@ constexpr double kInsideSlack = 1e-12;
 // The looser slack of that search, so that a line through an edge or vertex always finds a face.
 constexpr double kRingSlack = 1e-9;
 
-// Farthest a query or line origin may lie from the centre, in unit-box lengths, for Embree's
-// float scene (a ray or query beyond float range is invalid to it).
+// Farthest a closest-point query may lie from the centre, in unit-box lengths, for Embree's float
+// scene (a query beyond float range is invalid to it).
 constexpr double kReach = 1e30;
+// Farthest a line origin may lie from the centre, in unit-box lengths. Embree takes a ray whose
+// origin has a coordinate beyond its FLT_LARGE (1.844e18) as invalid, and a build of Embree with
+// assertions enabled (Debian's) aborts the process on such a ray.
+constexpr double kRayReach = 1e18;
 
 struct Hit {
   V3 point{kNaN, kNaN, kNaN};
@@ -251,12 +255,12 @@ struct SurfaceIndex::Impl {
         os[i] = (o[i] - centre) * scale;
         best[i] = Hit{};
       }
-      // An origin too far from the surface for float (beyond 1e30 unit-box lengths, or past the
-      // range of double) would make Embree's ray invalid: such a line is tested against every
-      // face in double instead (slow, but only for absurd input).
+      // An origin too far from the surface for Embree (beyond kRayReach unit-box lengths, or past
+      // the range of double) would make its ray invalid: such a line is tested against every face
+      // in double instead (slow, but only for absurd input).
       bool far[kBlock];
       for (int i = 0; i < n; ++i) {
-        far[i] = !(os[i].cwiseAbs().maxCoeff() <= kReach);
+        far[i] = !(os[i].cwiseAbs().maxCoeff() <= kRayReach);
         if (far[i]) {
           double t = 0.0, outside = 0.0;
           for (Index f = 0; f < faces.rows(); ++f) {
