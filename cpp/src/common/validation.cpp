@@ -164,10 +164,12 @@ void require_contact_tolerance(double value) {
   if (!std::isfinite(value)) invalid("contact_tolerance", "must be finite, got " + std::to_string(value));
 }
 
+void require_mesh_size(double value) {
+  if (!(value >= 0.0) || !std::isfinite(value)) invalid("mesh_size", "must be a finite length >= 0 (0: automatic)");
+}
+
 void require_diffusion_options(const DiffusionOptions& options) {
-  if (!(options.mesh_size >= 0.0) || !std::isfinite(options.mesh_size)) {
-    invalid("mesh_size", "must be a finite length >= 0 (0: automatic)");
-  }
+  require_mesh_size(options.mesh_size);
   if (!(options.mesh_fraction > 0.0) || !std::isfinite(options.mesh_fraction)) {
     invalid("mesh_fraction", "must be a finite number > 0");
   }

@@ -73,7 +73,11 @@ void require_volume(double volume, const Points3Ref& vertices, const char* name)
 // A contact tolerance (CurveMappingOptions::contact_tolerance) is finite; negative asks for the default.
 void require_contact_tolerance(double value);
 
-// A diffusion mesh size >= 0 and a mesh fraction > 0, both finite.
+// The mesh_size option of every kernel that meshes a region (2D and 3D diffusion, map_surfaces,
+// extend): a finite length >= 0, where 0 asks for the kernel's own size. One rule, one message.
+void require_mesh_size(double value);
+
+// A diffusion mesh size (require_mesh_size) and a mesh fraction > 0, both finite.
 void require_diffusion_options(const DiffusionOptions& options);
 
 // Number of worker threads the kernels use.

@@ -287,9 +287,7 @@ void require_options(const ExtendOptions& options) {
     detail::invalid("poisson_ratio", "must be at least 0 and below 0.5, got " + std::to_string(options.poisson_ratio));
   }
   if (options.substeps < 1) detail::invalid("substeps", "must be at least 1, got " + std::to_string(options.substeps));
-  if (!(options.mesh_size >= 0.0) || !std::isfinite(options.mesh_size)) {
-    detail::invalid("mesh_size", "must be a finite length >= 0 (0: automatic)");
-  }
+  detail::require_mesh_size(options.mesh_size);
 }
 
 // The mesh size for Mesh_3: the one asked for, else the start triangles' mean edge (checking that
@@ -308,7 +306,13 @@ double default_size(const DisplacementField3& field, const ExtendOptions& option
       total += (field.starts.row(field.faces(f, i)) - field.starts.row(field.faces(f, (i + 1) % 3))).norm();
     }
   }
-  return options.mesh_size > 0.0 ? options.mesh_size : total / (3.0 * field.faces.rows());
+  if (options.mesh_size > 0.0) return options.mesh_size;
+  const double mean = total / (3.0 * field.faces.rows());
+  if (!(mean > 0.0) || !std::isfinite(mean)) {
+    detail::invalid("field",
+                    "its triangles have no finite, non-zero mean edge length to size the mesh by: pass mesh_size");
+  }
+  return mean;
 }
 
 // The field on the given mesh (checked), or with no cells given on the one `make_mesh` puts into

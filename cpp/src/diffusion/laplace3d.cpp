@@ -59,9 +59,7 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 ShellDiffusionSolution solve_diffusion_3d(const Points3Ref& source_vertices, const FacesRef& source_faces,
                                           const Points3Ref& target_vertices, const FacesRef& target_faces,
                                           const ShellDiffusionOptions& options) {
-  if (!(options.mesh_size >= 0.0) || !std::isfinite(options.mesh_size)) {
-    detail::invalid("mesh_size", "must be a finite length >= 0");
-  }
+  detail::require_mesh_size(options.mesh_size);
   const auto clock = std::chrono::steady_clock::now();
   // Each surface checked, oriented outwards (Mesh_3 and the nesting tests want that) and put in
   // CGAL's form once, for the nesting, contact, crossing and meshing steps: the two at once.

@@ -20,7 +20,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cmath>
 #include <map>
 #include <set>
 #include <string>
@@ -152,8 +151,9 @@ void split_chords(VolumeMesh& mesh) {
 
 }  // namespace
 
+// `size` arrives resolved and > 0: the mesh_size option is checked where it enters
+// (require_mesh_size), the default where it is computed (extend's default_size).
 VolumeMesh mesh_volume(const Points3Ref& vertices, const FacesRef& faces, double size, int seed, const char* name) {
-  if (!(size > 0.0) || !std::isfinite(size)) invalid("mesh_size", "must be a finite number > 0");
   SurfaceMesh surface;
   try {
     surface = to_surface_mesh(vertices, faces);

@@ -14,7 +14,6 @@
 #include <morphomap/errors.hpp>
 
 #include <algorithm>
-#include <cmath>
 #include <iterator>
 #include <limits>
 #include <memory>
@@ -207,9 +206,7 @@ DisplacementField3 checked(Surface s1, Surface s2, const SurfaceMappingOptions& 
                     "lies apart from s1 (the surfaces neither cross nor enclose one another): consecutive "
                     "frames of one organ overlap; check their units and offsets");
   }
-  if (!(options.diffusion_mesh_size >= 0) || !std::isfinite(options.diffusion_mesh_size)) {
-    detail::invalid("mesh_size", "must be a finite number >= 0");
-  }
+  detail::require_mesh_size(options.diffusion_mesh_size);
   ShellDiffusionOptions diffusion;
   diffusion.mesh_size = options.diffusion_mesh_size;
   diffusion.repeatable = options.diffusion_repeatable;
