@@ -13,8 +13,8 @@
 
 #include "interrupt_guard.hpp"
 
-#include <iterator>
 #include <memory>
+#include <optional>
 #include <string>
 
 namespace py = pybind11;
@@ -89,10 +89,28 @@ void bind_mapping(py::module_& m) {
       py::arg("closed"), py::arg("n"), py::arg("anchor"), py::arg("density_threshold"), py::arg("contact_tolerance"),
       py::arg("mesh_size"), py::arg("mesh_fraction"), py::arg("stretch_weight"));
   m.attr("DEFAULT_STRETCH_WEIGHT") = kDefaultStretchWeight;
-  // The core's registry of names: what map_curves takes, and what a field's methods can say.
-  py::tuple map_methods(std::size(kMapMethods));
-  for (std::size_t i = 0; i < std::size(kMapMethods); ++i) map_methods[i] = map_method_name(kMapMethods[i]);
-  m.attr("MAP_METHODS") = map_methods;
+  // The core's method table, row by row (read-only views of kMethodTable): the subsets of methods
+  // that Python lists are read from it. MAP_METHODS: the names map_curves takes; METHOD_NAMES:
+  // what a field's method codes say.
+  const auto label = [](const std::optional<Method>& method) -> py::object {
+    return method ? py::object(py::str(method_name(*method))) : py::object(py::none());
+  };
+  py::class_<MethodRow>(m, "MethodRow")
+      .def_readonly("name", &MethodRow::name)
+      .def_property_readonly("forward", [label](const MethodRow& row) { return label(row.forward); })
+      .def_property_readonly("backward", [label](const MethodRow& row) { return label(row.backward); })
+      .def_property_readonly("basic", &MethodRow::basic)
+      .def_readonly("from_paper", &MethodRow::from_paper)
+      .def_readonly("curves", &MethodRow::curves)
+      .def_readonly("surfaces", &MethodRow::surfaces)
+      .def("__repr__", [](const MethodRow& row) { return std::string("<MethodRow '") + row.name + "'>"; });
+  py::list rows, map_methods;
+  for (const MethodRow& row : kMethodTable) {
+    rows.append(py::cast(&row, py::return_value_policy::reference));
+    if (row.curves) map_methods.append(row.name);
+  }
+  m.attr("METHODS") = py::tuple(rows);
+  m.attr("MAP_METHODS") = py::tuple(map_methods);
   py::tuple method_names(kMethodCount);
   for (int code = 0; code < kMethodCount; ++code) method_names[code] = method_name(static_cast<Method>(code));
   m.attr("METHOD_NAMES") = method_names;

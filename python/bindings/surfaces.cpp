@@ -15,7 +15,6 @@
 #include "interrupt_guard.hpp"
 #include "stage_callback.hpp"
 
-#include <iterator>
 #include <memory>
 #include <string>
 
@@ -35,9 +34,6 @@ py::dict hits_record(SurfaceHits&& h) {
 }  // namespace
 
 void bind_surfaces(py::module_& m) {
-  py::tuple surface_methods(std::size(kSurfaceMethods));  // the core's registry (map_method_name)
-  for (std::size_t i = 0; i < std::size(kSurfaceMethods); ++i) surface_methods[i] = map_method_name(kSurfaceMethods[i]);
-  m.attr("SURFACE_METHODS") = surface_methods;
   py::class_<SurfaceIndex>(m, "SurfaceIndex")
       .def(py::init<const Points3Ref&, const FacesRef&>(), py::arg("vertices"), py::arg("faces"), Release())
       .def(

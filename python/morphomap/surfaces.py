@@ -11,8 +11,9 @@ from ._progress import StageBar, as_progress
 from ._validate import as_choice, as_faces, as_flag, as_points, as_real
 from .field import DisplacementField
 
-#: What ``method`` takes: the core's registry (``kSurfaceMethods``), then ``"best"``, which is Python's.
-SURFACE_METHODS = tuple(_core.SURFACE_METHODS) + ("best",)
+#: What ``method`` takes: the methods with a 3D form in the core's method table, then ``"best"``,
+#: which is Python's.
+SURFACE_METHODS = tuple(row.name for row in _core.METHODS if row.surfaces) + ("best",)
 # The stages the core reports (SurfaceMappingOptions::on_stage), in order, for the progress bar.
 DIFFUSION_STAGES = ("mesh", "solve", "trace")
 _STAGES = {"diffusion": DIFFUSION_STAGES, "auto": ("normal",) + DIFFUSION_STAGES}

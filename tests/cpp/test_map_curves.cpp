@@ -181,8 +181,8 @@ void method_names_round_trip() {
     CHECK(false);
   } catch (const InvalidInput& e) {
     CHECK(std::string(e.what()) ==
-          "method: expected one of 'auto', 'minimal_distance', 'normal', 'diffusion', 'uniform' or 'optimal', got "
-          "'automatic'");
+          "method: expected one of 'auto', 'minimal_distance', 'normal', 'diffusion', 'uniform', 'optimal' or "
+          "'paper', got 'automatic'");
   }
   for (int code = 0; code < morphomap::kMethodCount; ++code) {
     const Method method = static_cast<Method>(code);

@@ -24,10 +24,11 @@ enum class Method : std::int8_t {
 };
 constexpr int kMethodCount = 10;
 
-// "minimal_distance", "normal", "diffusion", "uniform", "optimal", and "reverse_" before each.
+// The label's name, from the method table (kMethodTable in mapping.hpp): its algorithm's name,
+// with "reverse_" before it for a vector found from C2.
 std::string method_name(Method method);
 
-// The same algorithm run the other way: normal <-> reverse_normal, and so on.
+// The same algorithm run the other way (the table's other label): normal <-> reverse_normal, ...
 Method reversed(Method method);
 
 // Vectors starts[i] -> ends[i] from C1 to C2, in the order of the points of the curve the

@@ -6,6 +6,9 @@
 #include <morphomap/prepared_curve.hpp>
 #include <morphomap/types.hpp>
 
+#include <array>
+#include <cstddef>
+#include <iterator>
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,13 +17,46 @@ namespace morphomap {
 
 enum class MapMethod { minimal_distance, normal, diffusion, uniform, automatic, optimal, paper };
 
-// Every MapMethod, in the order users see them listed. Their names (map_method_name) are the one
-// registry that the core's messages, the Python bindings, the command line and the demo read.
-constexpr MapMethod kMapMethods[] = {MapMethod::automatic, MapMethod::minimal_distance, MapMethod::normal,
-                                     MapMethod::diffusion, MapMethod::uniform,          MapMethod::optimal,
-                                     MapMethod::paper};
+// One row per method that map_curves or map_surfaces takes, in the order users see them listed:
+// the one table of the methods' names and forms, which the core's messages, reversed(), the
+// Python bindings (and through them the command line, the demo and "best") read.
+struct MethodRow {
+  MapMethod method;
+  const char* name;
+  // A basic algorithm labels each of its vectors with one of two Methods: `forward` for a vector
+  // found from C1 (named `name`), `backward` for one found from C2 and flipped ("reverse_" +
+  // name); reversed() swaps them. The workflows (auto, paper) have neither: their vectors carry
+  // the labels of the basic algorithms they ran.
+  std::optional<Method> forward, backward;
+  bool from_paper;  // the paper's own: its four basic algorithms and its Algorithm 1
+  bool curves;      // has a 2D form (map_curves)
+  bool surfaces;    // has a 3D form (map_surfaces)
 
-// "auto" for automatic, else the enumerator's name.
+  constexpr bool basic() const { return forward.has_value(); }
+};
+
+constexpr MethodRow kMethodTable[] = {
+    {MapMethod::automatic, "auto", std::nullopt, std::nullopt, false, true, true},
+    {MapMethod::minimal_distance, "minimal_distance", Method::minimal_distance, Method::reverse_minimal_distance, true,
+     true, true},
+    {MapMethod::normal, "normal", Method::normal, Method::reverse_normal, true, true, true},
+    {MapMethod::diffusion, "diffusion", Method::diffusion, Method::reverse_diffusion, true, true, true},
+    {MapMethod::uniform, "uniform", Method::uniform, Method::reverse_uniform, true, true, false},
+    {MapMethod::optimal, "optimal", Method::optimal, Method::reverse_optimal, false, true, false},
+    {MapMethod::paper, "paper", std::nullopt, std::nullopt, true, true, false},
+};
+
+// The table's methods alone, in its order.
+constexpr auto kMapMethods = [] {
+  std::array<MapMethod, std::size(kMethodTable)> methods{};
+  for (std::size_t i = 0; i < methods.size(); ++i) methods[i] = kMethodTable[i].method;
+  return methods;
+}();
+
+// The row of `method` in kMethodTable.
+const MethodRow& method_row(MapMethod method);
+
+// The row's name: "auto" for automatic, else the enumerator's name.
 const char* map_method_name(MapMethod method);
 
 // The MapMethod called `name`: InvalidInput naming "method" (and listing the names) otherwise.
@@ -28,6 +64,8 @@ MapMethod map_method_named(const std::string& name);
 
 // The names of [first, last) in quotes: "'a', 'b' or 'c'" (for messages).
 std::string quoted_method_names(const MapMethod* first, const MapMethod* last);
+// The same for the rows of kMethodTable that have a form: &MethodRow::curves or ::surfaces.
+std::string quoted_method_names(bool MethodRow::*form);
 
 struct CurveMappingOptions {
   MapMethod method = MapMethod::automatic;  // the default's choice (map_curves below); paper: Algorithm 1

@@ -38,19 +38,6 @@ using detail::kNaN;
 // go to the unchecked variants; the query points are points of those curves.
 using Unchecked = detail::CurveIndexUnchecked;
 
-Method reversed(Method method) {
-  switch (method) {
-    case Method::optimal:
-      return Method::reverse_optimal;
-    case Method::reverse_optimal:
-      return Method::optimal;
-    default:
-      break;
-  }
-  const int code = static_cast<int>(method);
-  return static_cast<Method>(code < 4 ? code + 4 : code - 4);
-}
-
 namespace {
 
 using detail::ArcCurve;

@@ -1,57 +1,41 @@
-// The names of the methods: the one registry that the core's messages, the bindings, the command
-// line and the demo read.
+// Readers of the method table (kMethodTable, mapping.hpp): the methods' names, the names of the
+// labels their vectors carry, and the label of the same algorithm run the other way.
 #include <morphomap/field.hpp>
 #include <morphomap/mapping.hpp>
 
 #include "common/validation.hpp"
 
-#include <iterator>
 #include <string>
+#include <vector>
 
 namespace morphomap {
 
+const MethodRow& method_row(MapMethod method) {
+  for (const MethodRow& row : kMethodTable) {
+    if (row.method == method) return row;
+  }
+  detail::invalid("method", "code " + std::to_string(static_cast<int>(method)) + " has no row in the method table");
+}
+
 std::string method_name(Method method) {
-  switch (method) {
-    case Method::minimal_distance:
-      return "minimal_distance";
-    case Method::normal:
-      return "normal";
-    case Method::diffusion:
-      return "diffusion";
-    case Method::uniform:
-      return "uniform";
-    case Method::reverse_minimal_distance:
-      return "reverse_minimal_distance";
-    case Method::reverse_normal:
-      return "reverse_normal";
-    case Method::reverse_diffusion:
-      return "reverse_diffusion";
-    case Method::reverse_uniform:
-      return "reverse_uniform";
-    case Method::optimal:
-      return "optimal";
-    case Method::reverse_optimal:
-      return "reverse_optimal";
+  for (const MethodRow& row : kMethodTable) {
+    if (row.forward == method) return row.name;
+    if (row.backward == method) return std::string("reverse_") + row.name;
   }
   return "unknown";
 }
 
+Method reversed(Method method) {
+  for (const MethodRow& row : kMethodTable) {
+    if (row.forward == method) return *row.backward;
+    if (row.backward == method) return *row.forward;
+  }
+  return method;  // not a label of the table's (only a cast integer can be)
+}
+
 const char* map_method_name(MapMethod method) {
-  switch (method) {
-    case MapMethod::automatic:
-      return "auto";
-    case MapMethod::paper:
-      return "paper";
-    case MapMethod::minimal_distance:
-      return "minimal_distance";
-    case MapMethod::normal:
-      return "normal";
-    case MapMethod::diffusion:
-      return "diffusion";
-    case MapMethod::uniform:
-      return "uniform";
-    case MapMethod::optimal:
-      return "optimal";
+  for (const MethodRow& row : kMethodTable) {
+    if (row.method == method) return row.name;
   }
   return "unknown";
 }
@@ -65,11 +49,20 @@ std::string quoted_method_names(const MapMethod* first, const MapMethod* last) {
   return names;
 }
 
-MapMethod map_method_named(const std::string& name) {
-  for (const MapMethod method : kMapMethods) {
-    if (name == map_method_name(method)) return method;
+std::string quoted_method_names(bool MethodRow::*form) {
+  std::vector<MapMethod> methods;
+  for (const MethodRow& row : kMethodTable) {
+    if (row.*form) methods.push_back(row.method);
   }
-  detail::invalid("method", "expected one of " + quoted_method_names(std::begin(kMapMethods), std::end(kMapMethods)) +
+  return quoted_method_names(methods.data(), methods.data() + methods.size());
+}
+
+MapMethod map_method_named(const std::string& name) {
+  for (const MethodRow& row : kMethodTable) {
+    if (name == row.name) return row.method;
+  }
+  detail::invalid("method", "expected one of " +
+                                quoted_method_names(kMapMethods.data(), kMapMethods.data() + kMapMethods.size()) +
                                 ", got '" + name + "'");
 }
 

@@ -14,7 +14,6 @@
 #include <morphomap/errors.hpp>
 
 #include <algorithm>
-#include <iterator>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -188,9 +187,9 @@ const detail::ClosedSurface& closed_of(const Surface& surface, std::unique_ptr<c
 // map_surfaces on two checked surfaces: each converted to CGAL's form and tested for
 // self-intersections once, here, for every algorithm and direction the call runs.
 DisplacementField3 checked(Surface s1, Surface s2, const SurfaceMappingOptions& options) {
-  if (std::find(std::begin(kSurfaceMethods), std::end(kSurfaceMethods), options.method) == std::end(kSurfaceMethods)) {
+  if (!method_row(options.method).surfaces) {
     detail::invalid("method", std::string(map_method_name(options.method)) + " mapping has no 3D form; use " +
-                                  quoted_method_names(std::begin(kSurfaceMethods), std::end(kSurfaceMethods)));
+                                  quoted_method_names(&MethodRow::surfaces));
   }
   if (options.method == MapMethod::diffusion) {
     detail::require_volume(s1.volume, s1.vertices, "s1");

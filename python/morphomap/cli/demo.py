@@ -20,19 +20,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._core import GeometryError
-from ..field import METHOD_NAMES
+from .._core import METHODS, GeometryError
 from ..io import EXAMPLES, load_example, write_curve, write_field
 from ..io.atomic import atomic_text
 from ..mapping import map_curves
 from ..quality import quality
 
-#: The algorithms, in the paper's order, and the variants the demo runs for each.
-ALGORITHMS = METHOD_NAMES[:4]  # the paper's four basic algorithms: the core's first codes
+#: The paper's basic algorithms in 2D, in the order of the core's method table, and the variants
+#: the demo runs for each; then the basic algorithms beyond the paper, and "best".
+ALGORITHMS = tuple(row.name for row in METHODS if row.basic and row.from_paper and row.curves)
 VARIANTS = ("plain", "reverse", "transform")
 _VARIANT_ARGUMENTS = {"plain": {}, "reverse": {"reverse": True}, "transform": {"transform": True}}
-_TITLES = {"minimal_distance": "minimal distance", "normal": "normal", "diffusion": "diffusion",
-           "uniform": "uniform"}
+_BEYOND_PAPER = tuple(row.name for row in METHODS if row.basic and not row.from_paper and row.curves) + ("best",)
 _VARIANT_TITLES = {"plain": "", "reverse": "reverse ", "transform": "transformed "}
 
 
@@ -133,7 +132,7 @@ def run(out="morphomap-demo", *, pairs=EXAMPLES, stream=None, plots=True) -> lis
             for j, variant in enumerate(VARIANTS):
                 row = Row(pair, method, variant)
                 rows.append(row)
-                title = f"{_VARIANT_TITLES[variant]}{_TITLES[method]}".capitalize()
+                title = f"{_VARIANT_TITLES[variant]}{method.replace('_', ' ')}".capitalize()
                 tick = time.perf_counter()
                 try:
                     field = map_curves(c1, c2, method, split=True, **_VARIANT_ARGUMENTS[variant])
@@ -176,7 +175,7 @@ def run(out="morphomap-demo", *, pairs=EXAMPLES, stream=None, plots=True) -> lis
             save_figure(single, folder / "auto.png", dpi=100)
             written.append(folder / "auto.png")
         # Beyond the paper: the order-preserving optimal matching, and the best of every candidate.
-        for method in ("optimal", "best"):
+        for method in _BEYOND_PAPER:
             tick = time.perf_counter()
             field = map_curves(c1, c2, method)
             q = quality(field, c1, c2, closed=True)
@@ -225,7 +224,8 @@ def run(out="morphomap-demo", *, pairs=EXAMPLES, stream=None, plots=True) -> lis
 
 #: The 3D frames of the image demo and the algorithms run on each: the paper's Figure 12 case
 #: with its three algorithms, the lung-like pair with normal mapping (it folds) and auto.
-STACKS = {"figure12": ("minimal_distance", "normal", "diffusion"), "lung": ("normal", "auto")}
+STACKS = {"figure12": tuple(row.name for row in METHODS if row.basic and row.from_paper and row.surfaces),
+          "lung": ("normal", "auto")}
 
 
 def _write_frames(folder, name, first, second, spacing):
