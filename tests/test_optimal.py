@@ -87,10 +87,19 @@ def test_deep_narrow_bud_without_crossings():
     check_order_preserving(mm.map_curves(c1, c2, "optimal"), c1, c2)
 
 
+def test_fingers_up_to_four_long_map_without_crossings():
+    # The finger's long edges make the target uneven, so it is sampled through its vertices too
+    # (sample_arcs in optimal.cpp): the few start points facing it now reach its tip with vectors
+    # inside the region. Equally spaced samples alone found no such path at 3 (12 crossing pairs).
+    for depth in (3.0, 4.0):
+        c1, c2 = budded(depth)
+        check_order_preserving(mm.map_curves(c1, c2, "optimal"), c1, c2)
+
+
 def test_no_crossing_free_matching_is_refused():
-    # A finger 3 long: the few start points facing it cannot reach its tip with vectors inside the
-    # region (each step advances a bounded stretch of C2); the penalty left 12 crossing pairs.
-    c1, c2 = budded(3.0)
+    # A finger 5 long: the few start points facing it cannot reach its tip with vectors inside the
+    # region (each step advances a bounded stretch of C2).
+    c1, c2 = budded(5.0)
     with pytest.raises(mm.GeometryError, match="no crossing-free order-preserving matching"):
         mm.map_curves(c1, c2, "optimal")
 

@@ -35,6 +35,9 @@ constexpr Index kThinning = 4;     // starts per level
 constexpr Index kCoarsest = 256;   // the full grid is searched at or below this many starts
 constexpr Index kRecent = 3;       // vectors back along the path checked for crossings
 constexpr Index kWidenings = 2;    // with the region: doublings of a level's band before giving up
+// A target with an edge longer than this many times its median edge is sampled through its
+// vertices as well as evenly (sample_arcs).
+constexpr double kUneven = 4.0;
 
 // The problem of one call: start points with their arc positions, the two pieces' lengths, the
 // virtual vectors at both ends, and the weights.
@@ -49,6 +52,7 @@ struct Problem {
   double alpha = 1.0;
   const ArcCurve* target = nullptr;
   std::vector<double> vertex_arcs;      // arc position of each vertex of the target
+  bool uneven_target = false;           // an edge longer than kUneven times the median
   const MatchRegion* region = nullptr;  // the hard constraint, where the region is a polygon
 };
 
@@ -87,17 +91,22 @@ struct Level {
   std::vector<Index> first;
 };
 
-// The arc positions of M + 1 target samples: each the mean of an equally spaced position and the
-// position the same fraction of the way through the target's vertices. Outlines are traced densely
-// where they have detail and sparsely along long edges (a flank closed by one segment, a pixel
-// staircase's runs): equally spaced samples alone are coarser than the points there, and the
-// stretch term, which compares arc lengths between neighbours, then only sees multiples of the
-// sample step (bench/README.md, "Real 2D outlines"). Strictly increasing; the ends exact.
+// The arc positions of M + 1 target samples. Equally spaced on a target whose edges are about
+// even (none longer than kUneven times the median). On an uneven one, each the mean of an equally
+// spaced position and the position the same fraction of the way through the target's vertices:
+// outlines are traced densely where they have detail and sparsely along long edges (a flank closed
+// by one segment), equally spaced samples alone are coarser than the points there, and the stretch
+// term, which compares arc lengths between neighbours, then only sees multiples of the sample step
+// (bench/README.md, "Real 2D outlines"). Strictly increasing; the ends exact.
 std::vector<double> sample_arcs(const Problem& p, Index samples) {
   std::vector<double> t(samples + 1);
   const Index last_vertex = static_cast<Index>(p.vertex_arcs.size()) - 1;
   for (Index k = 0; k <= samples; ++k) {
     const double u = static_cast<double>(k) / static_cast<double>(samples);
+    if (!p.uneven_target) {
+      t[k] = u * p.target_length;
+      continue;
+    }
     const double x = u * static_cast<double>(last_vertex);
     const Index j = std::min<Index>(static_cast<Index>(x), last_vertex - 1);
     const double f = x - static_cast<double>(j);
@@ -390,8 +399,14 @@ MonotoneMatch detail::monotone_match_unchecked(const Points2Ref& source, const s
   p.alpha = p.source_length > 0.0 ? p.target_length / p.source_length : 1.0;
   p.target = &curve;
   p.vertex_arcs.assign(target.rows(), 0.0);
-  for (Index i = 1; i < target.rows(); ++i)
-    p.vertex_arcs[i] = p.vertex_arcs[i - 1] + (target.row(i) - target.row(i - 1)).norm();
+  std::vector<double> edges(target.rows() - 1);
+  for (Index i = 1; i < target.rows(); ++i) {
+    edges[i - 1] = (target.row(i) - target.row(i - 1)).norm();
+    p.vertex_arcs[i] = p.vertex_arcs[i - 1] + edges[i - 1];
+  }
+  const double longest = *std::max_element(edges.begin(), edges.end());
+  std::nth_element(edges.begin(), edges.begin() + edges.size() / 2, edges.end());
+  p.uneven_target = longest > kUneven * edges[edges.size() / 2];
   using Unchecked = detail::CurveIndexUnchecked;
   const double gap2 =
       Unchecked::closest_points(Unchecked::build(target, false), p.starts).distances.array().square().mean();
