@@ -58,6 +58,9 @@ arrays = st.one_of(
 def test_random_arrays_never_crash(name, value):
     try:
         CALLS[name](value)
+    except mm.GeometryError as error:
+        # The default's contract: a pair without a crossing-free complete field is said, not mapped.
+        assert name == "map_curves_auto" and str(error).startswith("map_curves: "), str(error)
     except (ValueError, TypeError) as error:
         assert str(error).split(":")[0] in {
             "points",

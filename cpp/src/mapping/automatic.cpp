@@ -2,6 +2,7 @@
 #include <morphomap/crossings.hpp>
 #include <morphomap/errors.hpp>
 #include <morphomap/quality.hpp>
+#include <morphomap/transform.hpp>
 
 #include "common/interrupt_check.hpp"
 #include "common/validation.hpp"
@@ -219,6 +220,82 @@ Vectors default_choice(const Job& job, const std::vector<double>& start_keys, co
                         "); try method='best', or map the other way round (reverse=True)");
   }
   return std::move(best.vectors);
+}
+
+namespace {
+
+// Appendix A's alignment without its greedy search (a tolerance above its first step): open curves
+// ends onto ends; closed ones scaled to C2's area about C1's centroid, and moved centroid onto
+// centroid where that overlaps more. The search would cost ten times the mapping
+// (bench/README.md, "Real 2D outlines").
+constexpr double kNoSearch = 1.0;
+
+// Start points carried back from a moved C1 by the inverse similarity lie on C1's points within
+// rounding, not bit for bit: the ones that do (in order along C1, skipping split points) are put
+// exactly on them.
+void snap_to(Points2& starts, const Points2Ref& curve, double tolerance) {
+  constexpr Index kLookahead = 3;  // rows of C1 without a start of their own (at a split point)
+  Index next = 0;
+  for (Index r = 0; r < starts.rows() && next < curve.rows(); ++r) {
+    for (Index i = next; i < std::min(curve.rows(), next + kLookahead); ++i) {
+      if ((starts.row(r) - curve.row(i)).norm() <= tolerance) {
+        starts.row(r) = curve.row(i);
+        next = i + 1;
+        break;
+      }
+    }
+  }
+}
+
+double field_qm(const DisplacementField2& field, const Points2Ref& c1, const Points2Ref& c2, bool closed) {
+  try {
+    const double qm = quality(field, c1, c2, closed).qm;
+    return std::isfinite(qm) ? qm : std::numeric_limits<double>::infinity();
+  } catch (const InvalidInput&) {
+    return std::numeric_limits<double>::infinity();
+  }
+}
+
+}  // namespace
+
+// "auto" without transform: the default's field of the pair as given, and of the pair with C1
+// moved near C2 by a similarity (carried back onto C1, so again one vector per point of C1); the
+// moved one counts only where it is complete and crossing-free on the curves as given; the lower
+// QM wins. Consecutive frames differ by growth more than by shape: mapped from a C1 of C2's size,
+// the vectors spread evenly (bench/README.md, "Real 2D outlines").
+DisplacementField2 mapped_choice(const Points2Ref& c1, Index n1, const CurveIndex* index1, const Points2Ref& c2,
+                                 Index n2, const CurveIndex* index2, const CurveMappingOptions& options) {
+  if (options.method != MapMethod::automatic || options.transform) {
+    return mapped_pair(c1, n1, index1, c2, n2, index2, options);
+  }
+  std::optional<DisplacementField2> plain;
+  std::string why;
+  try {
+    plain = mapped_pair(c1, n1, index1, c2, n2, index2, options);
+  } catch (const GeometryError& error) {
+    why = error.what();
+  }
+  std::optional<DisplacementField2> moved;
+  try {
+    const Points2 p1 = c1.topRows(n1), p2 = c2.topRows(n2);
+    const Similarity2 similarity = align_curves(p1, p2, options.closed, kNoSearch);
+    DisplacementField2 field = mapped_pair(c1, n1, index1, c2, n2, index2, options, &similarity);
+    const double size = (p1.colwise().maxCoeff() - p1.colwise().minCoeff()).norm();
+    snap_to(field.starts, p1, 1e-9 * size);
+    if (field.starts.allFinite() && field.ends.allFinite() && crossing_pairs(field.starts, field.ends).empty()) {
+      moved = std::move(field);
+    }
+  } catch (const GeometryError&) {  // the moved pair has no crossing-free field: the plain one stands
+  } catch (const InvalidInput&) {   // the moved C1 is not simple (rounding at a near-touch)
+  }
+  if (!moved) {
+    if (plain) return std::move(*plain);
+    throw GeometryError(why);
+  }
+  if (!plain) return std::move(*moved);
+  const Points2Ref a = c1.topRows(n1), b = c2.topRows(n2);
+  return field_qm(*moved, a, b, options.closed) < field_qm(*plain, a, b, options.closed) ? std::move(*moved)
+                                                                                         : std::move(*plain);
 }
 
 }  // namespace morphomap::detail

@@ -6,6 +6,7 @@
 #include <morphomap/field.hpp>
 #include <morphomap/laplace.hpp>
 #include <morphomap/mapping.hpp>
+#include <morphomap/transform.hpp>
 
 #include "curves/arc_curve.hpp"
 #include "curves/unchecked.hpp"
@@ -94,5 +95,17 @@ Vectors paper_algorithm(const Job& job, const std::vector<double>& start_keys, c
 // "auto": the default's choice on one job (automatic.cpp).
 Vectors default_choice(const Job& job, const std::vector<double>& start_keys, const ArcCurve& whole_source,
                        const CurveIndex& whole_source_index, const Settings& settings);
+
+// map_curves after its curves' checks: c1, c2 passed require_simple_curve, n1, n2 points of them
+// take part, and index1, index2 are their query indices where the caller has them (PreparedCurve),
+// else null. With `moved`, C1 is moved by that similarity before mapping and the start points are
+// carried back, as options.transform does with Appendix A's (mapping.cpp).
+DisplacementField2 mapped_pair(const Points2Ref& c1, Index n1, const CurveIndex* index1, const Points2Ref& c2, Index n2,
+                               const CurveIndex* index2, const CurveMappingOptions& options,
+                               const Similarity2* moved = nullptr);
+
+// mapped_pair, or for "auto" without transform the better of two whole fields (automatic.cpp).
+DisplacementField2 mapped_choice(const Points2Ref& c1, Index n1, const CurveIndex* index1, const Points2Ref& c2,
+                                 Index n2, const CurveIndex* index2, const CurveMappingOptions& options);
 
 }  // namespace morphomap::detail

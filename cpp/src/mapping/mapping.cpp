@@ -387,13 +387,9 @@ void validate_options(const CurveMappingOptions& options) {
   }
 }
 
-namespace {
-
-// map_curves after its curves' checks: c1, c2 passed require_simple_curve, n1, n2 points of
-// them take part, and index1, index2 are their query indices where the caller has them
-// (PreparedCurve), else null.
-DisplacementField2 mapped(const Points2Ref& c1, Index n1, const CurveIndex* index1, const Points2Ref& c2, Index n2,
-                          const CurveIndex* index2, const CurveMappingOptions& options) {
+DisplacementField2 detail::mapped_pair(const Points2Ref& c1, Index n1, const CurveIndex* index1, const Points2Ref& c2,
+                                       Index n2, const CurveIndex* index2, const CurveMappingOptions& options,
+                                       const Similarity2* moved) {
   const bool closed = options.closed;
   validate_options(options);
   // Frames of one organ overlap; closed curves that neither cross nor nest are the wrong pair
@@ -418,10 +414,14 @@ DisplacementField2 mapped(const Points2Ref& c1, Index n1, const CurveIndex* inde
   if (options.transform) {
     similarity = align_curves(a, b, closed);
     a = similarity.apply(a);
+  } else if (moved != nullptr) {
+    similarity = *moved;
+    a = similarity.apply(a);
   }
+  const bool transformed = options.transform || moved != nullptr;
   // Resampled or moved curves are new curves: checked once here as the core's functions check
   // theirs (the given ones passed require_simple_curve, at the entry or when prepared).
-  const bool derived = options.n > 0 || options.transform;
+  const bool derived = options.n > 0 || transformed;
   if (derived) {
     detail::require_curve(a, closed, "c1");
     detail::require_curve(b, closed, "c2");
@@ -429,7 +429,7 @@ DisplacementField2 mapped(const Points2Ref& c1, Index n1, const CurveIndex* inde
   std::optional<std::pair<Vec2, Vec2>> anchors;
   if (options.anchor) {
     Points2 anchor = options.anchor->transpose();
-    if (options.transform) anchor = similarity.apply(anchor);
+    if (transformed) anchor = similarity.apply(anchor);
     const Vec2 on_c1 = closest_points(anchor, a, closed).points.row(0).transpose();
     const Vec2 on_c2 = closest_points(on_c1.transpose(), b, closed).points.row(0).transpose();
     anchors = options.reverse ? std::make_pair(on_c2, on_c1) : std::make_pair(on_c1, on_c2);
@@ -454,7 +454,7 @@ DisplacementField2 mapped(const Points2Ref& c1, Index n1, const CurveIndex* inde
   if (options.reverse) {
     for (Method& m : field.methods) m = reversed(m);
   }
-  if (options.transform) field.starts = similarity.apply_inverse(field.starts);
+  if (transformed) field.starts = similarity.apply_inverse(field.starts);
   // Resampled curves cut the corners of the given ones: the points found on them go onto the
   // curves the caller passed, so that quality(field, c1, c2) measures the field on those.
   if (options.n > 0) {
@@ -464,12 +464,10 @@ DisplacementField2 mapped(const Points2Ref& c1, Index n1, const CurveIndex* inde
   return field;
 }
 
-}  // namespace
-
 DisplacementField2 map_curves(const Points2Ref& c1, const Points2Ref& c2, const CurveMappingOptions& options) {
   const Index n1 = detail::require_simple_curve(c1, options.closed, "c1");
   const Index n2 = detail::require_simple_curve(c2, options.closed, "c2");
-  return mapped(c1, n1, nullptr, c2, n2, nullptr, options);
+  return detail::mapped_choice(c1, n1, nullptr, c2, n2, nullptr, options);
 }
 
 DisplacementField2 map_curves(const PreparedCurve& c1, const PreparedCurve& c2, const CurveMappingOptions& options) {
@@ -477,8 +475,8 @@ DisplacementField2 map_curves(const PreparedCurve& c1, const PreparedCurve& c2, 
   c2.require_closed(options.closed, "c2");
   const Points2& p1 = c1.points();
   const Points2& p2 = c2.points();
-  return mapped(p1, detail::curve_size(p1, options.closed), &c1.index(), p2, detail::curve_size(p2, options.closed),
-                &c2.index(), options);
+  return detail::mapped_choice(p1, detail::curve_size(p1, options.closed), &c1.index(), p2,
+                               detail::curve_size(p2, options.closed), &c2.index(), options);
 }
 
 CurveSplit split_curves(const Points2Ref& c1, const Points2Ref& c2, bool closed, bool split, double contact_tolerance) {
