@@ -141,6 +141,11 @@ class Worker:
         valid = np.asarray(field.valid)
         result.update(vectors=int(len(field)), valid=int(valid.sum()),
                       methods=sorted(set(np.asarray(field.method).tolist())))
+        if dim == 2:
+            # The straight vectors' crossings: the 2D default returns none (or raises), and a pair
+            # on which a basic method answers without crossings or misses must not make it raise.
+            result["crossings"] = int(mm.count_crossings(np.asarray(field.starts)[valid],
+                                                         np.asarray(field.ends)[valid]))
         if method not in ("diffusion", "auto"):
             return result
 

@@ -110,14 +110,22 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
         see :func:`solve_diffusion`) from each start point to C2.
         ``"auto"`` (the default): on each pair of segments between split points (or the whole
         pair), the candidate without crossings (counted with the split points' own vectors) or
-        misses and of lowest QM on that pair, among normal mapping and ``"optimal"`` (both cost
-        milliseconds); where neither qualifies, diffusion, then minimal distance. Every candidate
-        maps the segment's own start points, so the field has one vector per point of C1 (and per
+        misses and of lowest QM on that pair, among normal mapping, ``"optimal"``, minimal
+        distance, and reverse minimal distance and reverse optimal carried onto the segment's
+        start points (each end the same fraction of the way along C2 between the reverse vectors
+        either side; milliseconds); where none of these qualifies with QM <= 1, also diffusion and
+        reverse diffusion carried so (tenths of a second). Every candidate maps the segment's own
+        start points, so the field has one vector per point of C1 (and per
         crossing), in order along C1. Where no candidate qualifies on a pair, or the pairs' fields
         cross each other, :class:`GeometryError` says how many start points and where: the
-        default never returns a crossing or incomplete field. Why not Algorithm 1: on real
-        outlines its reverse diffusion vectors cross where the streamlines fan into a lobe, and
-        they start from C2's points (bench/README.md, "Real 2D outlines").
+        default never returns a crossing or incomplete field. It also maps C1 moved near C2 by
+        Appendix A's similarity without its greedy search (open curves: ends onto ends; closed:
+        scaled to C2's area, centroid onto centroid), carried back onto C1's points, and keeps
+        that field where it has no crossings on the curves as given and a lower QM. With
+        ``transform=True`` it maps the transformed C1 only, and raises where the field carried
+        back crosses. Why not Algorithm 1: on real outlines its reverse diffusion vectors cross
+        where the streamlines fan into a lobe, and they start from C2's points (bench/README.md,
+        "Real 2D outlines").
         ``"paper"``: the paper's Algorithm 1 as stated (Tables 1 and 2 and its figures): split at
         intersections, normal mapping on each pair of segments, and reverse diffusion for a pair
         where normal mapping gives crossings or misses. Where reverse diffusion fails on a pair

@@ -97,11 +97,16 @@ struct CurveMappingOptions {
 // InvalidInput naming "c1" or "c2" otherwise.
 // "auto" (the default): on each piece between split points (or the whole pair), the candidate
 // with no crossings (counted with the split points' own vectors) and no misses and the lowest QM
-// on the piece, among normal mapping and the order-preserving optimal matching; where neither
-// qualifies, diffusion, then minimal distance. Every candidate maps the piece's own start points,
-// so the field has one vector per start point of C1 (and per crossing), in order along C1. Where
-// no candidate qualifies on a piece, or the pieces' fields cross each other, GeometryError says
-// how many start points and where: a crossing or incomplete field is never returned.
+// on the piece, among normal mapping, the order-preserving optimal matching, minimal distance, and
+// reverse minimal distance and reverse optimal carried onto the piece's start points; where none
+// qualifies with QM <= 1, also diffusion and reverse diffusion carried so. Every candidate maps
+// the piece's own start points, so the field has one vector per start point of C1 (and per
+// crossing), in order along C1. Where no candidate qualifies on a piece, or the pieces' fields
+// cross each other, GeometryError says how many start points and where: a crossing or incomplete
+// field is never returned. The same is done for C1 moved near C2 by Appendix A's similarity
+// without its greedy search, carried back onto C1, and the field of lower QM kept (the moved one
+// only without crossings on the curves as given). With transform, the transformed C1 only, and
+// GeometryError where that field crosses once carried back.
 // "paper": the paper's Algorithm 1 as stated: normal mapping on each piece, reverse diffusion where
 // it gives crossings or misses; where reverse diffusion fails on a piece (its mesh cannot be made,
 // streamlines stall) it falls back to diffusion, then to normal mapping (if that missed nothing),

@@ -111,19 +111,34 @@ Scored measured(const Job& job, Vectors v) {
 
 // A reverse field (from the target's points) carried onto the job's own start points: each start
 // point's end lies the same fraction of the way along the target between the ends of the two
-// reverse vectors whose starts bracket it on the source (the piece's ends bracket the first and
-// the last). Open pieces only, and only where the reverse field keeps the order (else none).
+// reverse vectors whose starts bracket it on the source. On an open piece its ends bracket the
+// first and the last start; on whole closed curves the brackets wrap round, and the target is
+// walked the way it turns relative to the source. None where the reverse field does not keep the
+// order (its ends, taken in the order of its starts along the source, step back along the target).
 std::optional<Vectors> carried(const Vectors& back, const Job& job, const std::vector<double>& start_keys,
                                Method label) {
-  if (job.source_closed || !complete(back) || back.starts.rows() == 0) return std::nullopt;
-  const ArcCurve source = ArcCurve::unchecked(job.source, false);
-  const ArcCurve target = ArcCurve::unchecked(job.target, false);
-  const Vector a = Unchecked::closest_points(Unchecked::build(job.source, false), back.starts).arc_lengths;
+  if (!complete(back) || back.starts.rows() == 0) return std::nullopt;
+  const bool closed = job.source_closed;
+  const ArcCurve source = ArcCurve::unchecked(job.source, closed);
+  const ArcCurve target = ArcCurve::unchecked(job.target, closed);
+  const double ls = source.length(), lt = target.length();
+  const Vector a = Unchecked::closest_points(Unchecked::build(job.source, closed), back.starts).arc_lengths;
   const Vector b = Unchecked::closest_points(target_index(job), back.ends).arc_lengths;
-  std::vector<std::pair<double, double>> knots{{0.0, 0.0}};
+  // Knots (arc along the source, arc along the target unrolled from the first knot's end).
+  std::vector<std::pair<double, double>> knots;
+  const int way = closed ? relative_direction(source, target) : 1;
+  if (!closed) knots.emplace_back(0.0, 0.0);
   for (Index j = 0; j < a.size(); ++j) knots.emplace_back(a[j], b[j]);
-  knots.emplace_back(source.length(), target.length());
+  if (!closed) knots.emplace_back(ls, lt);
   std::sort(knots.begin(), knots.end());
+  double origin = 0.0;
+  if (closed) {
+    origin = knots.front().second;
+    for (auto& k : knots) k.second = std::fmod(way * (k.second - origin) + 2.0 * lt, lt);
+    // Once round: the first knot again at the end, a whole turn of both curves on.
+    knots.emplace_back(knots.front().first + ls, knots.front().second + lt);
+    knots.insert(knots.begin(), {knots[knots.size() - 2].first - ls, knots[knots.size() - 2].second - lt});
+  }
   for (std::size_t k = 1; k < knots.size(); ++k) {
     if (knots[k].second < knots[k - 1].second) return std::nullopt;
   }
@@ -140,7 +155,8 @@ std::optional<Vectors> carried(const Vectors& back, const Job& job, const std::v
     const auto below = std::prev(above);
     const double span = above->first - below->first;
     const double f = span > 0.0 ? std::clamp((s - below->first) / span, 0.0, 1.0) : 0.0;
-    v.ends.row(j) = target.point_at(below->second + f * (above->second - below->second)).transpose();
+    const double along = below->second + f * (above->second - below->second);
+    v.ends.row(j) = target.point_at(closed ? target.wrap(origin + way * along) : along).transpose();
   }
   return v;
 }
@@ -158,8 +174,9 @@ std::string job_place(const Job& job) {
 }  // namespace
 
 // The default, on each job: the crossing-free, complete candidate of lowest QM. First the ones
-// that cost milliseconds: normal mapping, the order-preserving optimal matching, minimal distance
-// and reverse minimal distance carried onto the start points. Where none of them qualifies with
+// that cost milliseconds: normal mapping, the order-preserving optimal matching, minimal distance,
+// and reverse minimal distance and reverse optimal carried onto the start points (a coarse C1
+// matched from a fine C2 is matched from its own few points). Where none of them qualifies with
 // QM <= kGoodEnough, also the ones that solve a diffusion problem (tenths of a second): diffusion
 // and reverse diffusion carried onto the start points. Where none qualifies, GeometryError. Every
 // candidate maps the job's own start points, so the field has one vector per start point of C1,
@@ -211,6 +228,7 @@ Vectors default_choice(const Job& job, const std::vector<double>& start_keys, co
   consider(attempt("optimal", plain(MapMethod::optimal)));
   consider(attempt("minimal_distance", plain(MapMethod::minimal_distance)));
   consider(attempt("reverse_minimal_distance", backwards(MapMethod::minimal_distance)));
+  consider(attempt("reverse_optimal", backwards(MapMethod::optimal)));
   if (!best.failure.empty() || !(best.qm <= kGoodEnough)) {
     consider(attempt("diffusion", plain(MapMethod::diffusion)));
     consider(attempt("reverse_diffusion", backwards(MapMethod::diffusion)));
@@ -231,20 +249,28 @@ namespace {
 constexpr double kNoSearch = 1.0;
 
 // Start points carried back from a moved C1 by the inverse similarity lie on C1's points within
-// rounding, not bit for bit: the ones that do (in order along C1, skipping split points) are put
-// exactly on them.
-void snap_to(Points2& starts, const Points2Ref& curve, double tolerance) {
+// rounding, not bit for bit: the ones that do (in order along C1) are put exactly on them. The
+// others are split points where the moved C1 met C2, not points of C1: their rows are dropped.
+void keep_points_of(DisplacementField2& field, const Points2Ref& curve, double tolerance) {
   constexpr Index kLookahead = 3;  // rows of C1 without a start of their own (at a split point)
+  std::vector<Index> kept;
   Index next = 0;
-  for (Index r = 0; r < starts.rows() && next < curve.rows(); ++r) {
+  for (Index r = 0; r < field.starts.rows() && next < curve.rows(); ++r) {
     for (Index i = next; i < std::min(curve.rows(), next + kLookahead); ++i) {
-      if ((starts.row(r) - curve.row(i)).norm() <= tolerance) {
-        starts.row(r) = curve.row(i);
+      if ((field.starts.row(r) - curve.row(i)).norm() <= tolerance) {
+        field.starts.row(r) = curve.row(i);
+        kept.push_back(r);
         next = i + 1;
         break;
       }
     }
   }
+  if (static_cast<Index>(kept.size()) == field.starts.rows()) return;
+  field.starts = Points2(field.starts(kept, Eigen::all));
+  field.ends = Points2(field.ends(kept, Eigen::all));
+  std::vector<Method> methods;
+  for (const Index r : kept) methods.push_back(field.methods[r]);
+  field.methods = std::move(methods);
 }
 
 double field_qm(const DisplacementField2& field, const Points2Ref& c1, const Points2Ref& c2, bool closed) {
@@ -265,8 +291,19 @@ double field_qm(const DisplacementField2& field, const Points2Ref& c1, const Poi
 // the vectors spread evenly (bench/README.md, "Real 2D outlines").
 DisplacementField2 mapped_choice(const Points2Ref& c1, Index n1, const CurveIndex* index1, const Points2Ref& c2,
                                  Index n2, const CurveIndex* index2, const CurveMappingOptions& options) {
-  if (options.method != MapMethod::automatic || options.transform) {
-    return mapped_pair(c1, n1, index1, c2, n2, index2, options);
+  if (options.method != MapMethod::automatic) return mapped_pair(c1, n1, index1, c2, n2, index2, options);
+  if (options.transform) {
+    // Crossing-free on the moved C1 need not be on C1 as given: said, never returned.
+    DisplacementField2 field = mapped_pair(c1, n1, index1, c2, n2, index2, options);
+    const auto pairs = crossing_pairs(field.starts, field.ends);
+    if (!pairs.empty()) {
+      throw GeometryError("map_curves: the field mapped from C1 moved by Appendix A's transform has " +
+                          std::to_string(pairs.size()) +
+                          " crossing pairs once its start points are carried back onto C1; map without "
+                          "transform=True (the default tries a moved C1 itself and keeps it only without "
+                          "crossings)");
+    }
+    return field;
   }
   std::optional<DisplacementField2> plain;
   std::string why;
@@ -281,7 +318,7 @@ DisplacementField2 mapped_choice(const Points2Ref& c1, Index n1, const CurveInde
     const Similarity2 similarity = align_curves(p1, p2, options.closed, kNoSearch);
     DisplacementField2 field = mapped_pair(c1, n1, index1, c2, n2, index2, options, &similarity);
     const double size = (p1.colwise().maxCoeff() - p1.colwise().minCoeff()).norm();
-    snap_to(field.starts, p1, 1e-9 * size);
+    keep_points_of(field, p1, 1e-9 * size);
     if (field.starts.allFinite() && field.ends.allFinite() && crossing_pairs(field.starts, field.ends).empty()) {
       moved = std::move(field);
     }
