@@ -434,7 +434,9 @@ def map_repaired(error: ValueError, c1, c2, closed: bool, run):
         (r1, r2), (changes1, changes2) = repaired_curves(c1, c2, closed, stacklevel=3)
     except ValueError as refusal:
         # The core's message first (it counts the loops or the meeting pairs), then why the repair
-        # does not apply.
+        # does not apply, where that says more (a curve of too few points is refused alike).
+        if str(refusal) == str(error):
+            raise error from None
         raise ValueError(f"{error} (morphomap.make_simple does not repair it either: {refusal})") from None
     if changes1 is None and changes2 is None:
         raise error

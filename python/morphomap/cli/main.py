@@ -265,9 +265,10 @@ def main(argv=None) -> int:
     common.add_argument(
         "--smooth",
         type=_length,
-        default=0.0,
+        default=None,
         metavar="W",
-        help="Gaussian width (physical units) applied to masks before contouring (default 0)",
+        help="Gaussian width (physical units) applied to masks before contouring (default: about a "
+        "pixel for 2D masks, a sub-pixel outline; 0 for 3D stacks; 0: the pixels as they are)",
     )
     common.add_argument(
         "--edge-length",

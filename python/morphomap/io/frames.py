@@ -7,11 +7,13 @@ import os
 IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".npy")
 
 
-def read_boundary(path, *, spacing=None, label=None, smooth=0.0, edge_length=None, report=None):
+def read_boundary(path, *, spacing=None, label=None, smooth=None, edge_length=None, report=None):
     """``(boundary, from_image)``: the curve in a CSV file, the surface in a mesh file (STL, PLY,
     OBJ, OFF), or the boundary of the mask in an image file (a 2D mask gives a curve, a 3D stack a
     surface), at ``spacing`` (one value or one per axis), else the spacing the file states, else 1.
 
+    ``smooth``: as :func:`boundary_from_mask` and :func:`surface_from_mask` take it; None is
+    each one's default (a sub-pixel outline of a 2D mask, a 3D stack unsmoothed).
     ``report``, given, is called with one line saying which spacing was used.
     """
     from ..images import boundary_from_mask, read_image, surface_from_mask
@@ -37,4 +39,5 @@ def read_boundary(path, *, spacing=None, label=None, smooth=0.0, edge_length=Non
         report(f"{name}: {unit} spacing {' x '.join(f'{v:g}' for v in spacing)} ({source})")
     if data.ndim == 2:
         return boundary_from_mask(data, spacing, label=label, smooth=smooth), True
-    return surface_from_mask(data, spacing, label=label, smooth=smooth, edge_length=edge_length), True
+    return surface_from_mask(data, spacing, label=label, smooth=0.0 if smooth is None else smooth,
+                             edge_length=edge_length), True
