@@ -115,8 +115,8 @@ def run(out="morphomap-demo", *, pairs=EXAMPLES, stream=None, plots=True) -> lis
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
     print(f"morphomap demo: {len(pairs)} example pairs x {len(ALGORITHMS)} algorithms x {len(VARIANTS)} variants "
-          "(plain, reverse, transformed), then the automatic workflow (the paper's Algorithm 1, the "
-          "default); every mapping with split=True (the curves are split where they cross and each "
+          "(plain, reverse, transformed), then the default (auto: per piece the crossing-free, "
+          "complete candidate of lowest QM); every mapping with split=True (the curves are split where they cross and each "
           "pair of segments is mapped on its own).", file=stream)
     rows, written, auto_used = [], [], {}
     started = time.perf_counter()
@@ -158,7 +158,7 @@ def run(out="morphomap-demo", *, pairs=EXAMPLES, stream=None, plots=True) -> lis
                     save_figure(single, stem.with_suffix(".png"), dpi=100)
                     written.append(stem.with_suffix(".png"))
                     plot_field(field, c1, c2, ax=axes[i, j], title=label)
-        # The default: normal mapping, reverse diffusion where it crosses or misses.
+        # The default: per piece the crossing-free, complete candidate of lowest QM.
         field = map_curves(c1, c2)
         q = quality(field, c1, c2, closed=True)
         names, counts = np.unique(field.method, return_counts=True)
