@@ -3,9 +3,10 @@ crossing-free, miss-free one with the lowest QM.
 
 The candidates (2D, :func:`map_curves`): normal, minimal distance and diffusion mapping, each plain,
 reversed (``reverse=True``), transformed (``transform=True``) and both; ``"optimal"``; and
-``"auto"`` (the default, itself a per-piece choice among the cheap candidates). 3D (:func:`map_surfaces`): normal, minimal distance and
-diffusion, plain and reversed, and ``"auto"``. Each candidate runs once on the whole pair with the
-same options (splitting at crossings and contact stretches inside it as usual).
+``"auto"`` (the default, itself a per-piece choice among the cheap candidates). 3D
+(:func:`map_surfaces`): normal, minimal distance and diffusion, plain and reversed, and ``"auto"``.
+Each candidate runs once on the whole pair with the same options (splitting at crossings and
+contact stretches inside it as usual).
 
 Subproblems (2D): the pieces between the split points at the curves' crossings and contact
 stretches, as ``map_curves`` splits them (the core's ``split_curves``: one rule for both). On each

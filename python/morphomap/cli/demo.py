@@ -116,8 +116,8 @@ def run(out="morphomap-demo", *, pairs=EXAMPLES, stream=None, plots=True) -> lis
     out.mkdir(parents=True, exist_ok=True)
     print(f"morphomap demo: {len(pairs)} example pairs x {len(ALGORITHMS)} algorithms x {len(VARIANTS)} variants "
           "(plain, reverse, transformed), then the default (auto: per piece the crossing-free, "
-          "complete candidate of lowest QM); every mapping with split=True (the curves are split where they cross and each "
-          "pair of segments is mapped on its own).", file=stream)
+          "complete candidate of lowest QM); every mapping with split=True (the curves are split where "
+          "they cross and each pair of segments is mapped on its own).", file=stream)
     rows, written, auto_used = [], [], {}
     started = time.perf_counter()
     for pair in pairs:
