@@ -83,7 +83,8 @@ def test_default_on_the_kidney_pair_beats_algorithm_1():
     # Algorithm 1's QM here is 39.9: its reverse diffusion vectors bunch up on the buds.
     assert q.qm < 0.05 * paper.qm
     # The cheap candidates sufficed: no diffusion problem was solved.
-    assert set(field.method.tolist()) <= {"normal", "optimal", "minimal_distance", "reverse_minimal_distance"}
+    assert set(field.method.tolist()) <= {"normal", "optimal", "minimal_distance", "reverse_minimal_distance",
+                                          "reverse_optimal"}
 
 
 def test_default_maps_from_c1_where_algorithm_1_maps_from_c2():
@@ -104,3 +105,16 @@ def test_default_keeps_normal_mapping_where_it_is_best():
     check_default(field, c1, c2)
     np.testing.assert_allclose(np.hypot(*field.ends.T), 2.0, rtol=1e-12)
 
+
+
+def test_default_reversed_and_resampled_keep_the_contract():
+    # reverse=True: one vector per point of C2 (found from C2), none crossing; n: the resampled
+    # points. Neither takes the moved-C1 field, whose start points are C1's own rows.
+    c1, c2 = mm.load_example("kidney")
+    back = mm.map_curves(c1, c2, reverse=True)
+    q = mm.quality(back, c1, c2)
+    assert back.valid.all() and q.crossings == 0
+    assert mm.closest_points(c2, back.ends).distances.max() < 1e-12
+    resampled = mm.map_curves(c1, c2, n=120)
+    q = mm.quality(resampled, c1, c2)
+    assert resampled.valid.all() and q.crossings == 0 and len(resampled) >= 120

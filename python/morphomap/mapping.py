@@ -118,7 +118,8 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
         start points, so the field has one vector per point of C1 (and per
         crossing), in order along C1. Where no candidate qualifies on a pair, or the pairs' fields
         cross each other, :class:`GeometryError` says how many start points and where: the
-        default never returns a crossing or incomplete field. It also maps C1 moved near C2 by
+        default never returns a crossing or incomplete field. Without ``n`` or ``reverse`` it
+        also maps C1 moved near C2 by
         Appendix A's similarity without its greedy search (open curves: ends onto ends; closed:
         scaled to C2's area, centroid onto centroid), carried back onto C1's points, and keeps
         that field where it has no crossings on the curves as given and a lower QM. With

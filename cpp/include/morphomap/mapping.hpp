@@ -103,7 +103,8 @@ struct CurveMappingOptions {
 // the piece's own start points, so the field has one vector per start point of C1 (and per
 // crossing), in order along C1. Where no candidate qualifies on a piece, or the pieces' fields
 // cross each other, GeometryError says how many start points and where: a crossing or incomplete
-// field is never returned. The same is done for C1 moved near C2 by Appendix A's similarity
+// field is never returned. Without n or reverse, the same is done for C1 moved near C2 by
+// Appendix A's similarity
 // without its greedy search, carried back onto C1, and the field of lower QM kept (the moved one
 // only without crossings on the curves as given). With transform, the transformed C1 only, and
 // GeometryError where that field crosses once carried back.

@@ -35,11 +35,11 @@ double point_density(const Job& job, const Points2& starts) {
 
 }  // namespace
 
-// One job with one algorithm. "auto" is the paper's Algorithm 1 on the job: normal mapping, and
-// reverse diffusion instead when normal mapping gives crossings or misses (with a density
-// threshold, the first attempt is reverse minimal distance where the start points are denser
-// than the threshold: the paper's "limiting case of an infinite number of points"). Where reverse
-// diffusion fails on a piece (its mesh cannot be made, streamlines stall), "auto" still answers:
+// "paper": the paper's Algorithm 1 on one job: normal mapping, and reverse diffusion instead when
+// normal mapping gives crossings or misses (with a density threshold, the first attempt is reverse
+// minimal distance where the start points are denser than the threshold: the paper's "limiting
+// case of an infinite number of points"). Where reverse diffusion fails on a piece (its mesh
+// cannot be made, streamlines stall), it still answers:
 // forward diffusion, which is crossing-free too; then the first attempt if it missed nothing
 // (crossings and all); then minimal distance, which always finds a point.
 Vectors paper_algorithm(const Job& job, const std::vector<double>& start_keys, const ArcCurve& whole_source,
@@ -284,8 +284,8 @@ double field_qm(const DisplacementField2& field, const Points2Ref& c1, const Poi
 
 }  // namespace
 
-// "auto" without transform: the default's field of the pair as given, and of the pair with C1
-// moved near C2 by a similarity (carried back onto C1, so again one vector per point of C1); the
+// "auto" without transform, n or reverse: the default's field of the pair as given, and of the
+// pair with C1 moved near C2 by a similarity (carried back onto C1, so again one vector per point of C1); the
 // moved one counts only where it is complete and crossing-free on the curves as given; the lower
 // QM wins. Consecutive frames differ by growth more than by shape: mapped from a C1 of C2's size,
 // the vectors spread evenly (bench/README.md, "Real 2D outlines").
@@ -311,6 +311,12 @@ DisplacementField2 mapped_choice(const Points2Ref& c1, Index n1, const CurveInde
     plain = mapped_pair(c1, n1, index1, c2, n2, index2, options);
   } catch (const GeometryError& error) {
     why = error.what();
+  }
+  // The moved field's start points are C1's own rows only when C1's points are the start points
+  // (not resampled, not found from C2).
+  if (options.reverse || options.n > 0) {
+    if (plain) return std::move(*plain);
+    throw GeometryError(why);
   }
   std::optional<DisplacementField2> moved;
   try {
