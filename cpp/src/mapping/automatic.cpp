@@ -4,7 +4,7 @@
 #include <morphomap/quality.hpp>
 #include <morphomap/transform.hpp>
 
-#include "common/interrupt_check.hpp"
+#include "common/run_both.hpp"
 #include "common/validation.hpp"
 #include "curves/arc_curve.hpp"
 #include "curves/unchecked.hpp"
@@ -305,32 +305,35 @@ DisplacementField2 mapped_choice(const Points2Ref& c1, Index n1, const CurveInde
     }
     return field;
   }
-  std::optional<DisplacementField2> plain;
-  std::string why;
-  try {
-    plain = mapped_pair(c1, n1, index1, c2, n2, index2, options);
-  } catch (const GeometryError& error) {
-    why = error.what();
-  }
   // The moved field's start points are C1's own rows only when C1's points are the start points
-  // (not resampled, not found from C2).
-  if (options.reverse || options.n > 0) {
-    if (plain) return std::move(*plain);
-    throw GeometryError(why);
-  }
-  std::optional<DisplacementField2> moved;
-  try {
-    const Points2 p1 = c1.topRows(n1), p2 = c2.topRows(n2);
-    const Similarity2 similarity = align_curves(p1, p2, options.closed, kNoSearch);
-    DisplacementField2 field = mapped_pair(c1, n1, index1, c2, n2, index2, options, &similarity);
-    const double size = (p1.colwise().maxCoeff() - p1.colwise().minCoeff()).norm();
-    keep_points_of(field, p1, 1e-9 * size);
-    if (field.starts.allFinite() && field.ends.allFinite() && crossing_pairs(field.starts, field.ends).empty()) {
-      moved = std::move(field);
+  // (not resampled, not found from C2). The two passes are independent: both cores at once (the
+  // kidney at 10^4 points per curve, bench/README.md, "Real 2D outlines").
+  const bool try_moved = !(options.reverse || options.n > 0);
+  std::optional<DisplacementField2> plain, moved;
+  std::string why;
+  auto run_plain = [&] {
+    try {
+      plain = mapped_pair(c1, n1, index1, c2, n2, index2, options);
+    } catch (const GeometryError& error) {
+      why = error.what();
     }
-  } catch (const GeometryError&) {  // the moved pair has no crossing-free field: the plain one stands
-  } catch (const InvalidInput&) {   // the moved C1 is not simple (rounding at a near-touch)
-  }
+  };
+  auto run_moved = [&] {
+    if (!try_moved) return;
+    try {
+      const Points2 p1 = c1.topRows(n1), p2 = c2.topRows(n2);
+      const Similarity2 similarity = align_curves(p1, p2, options.closed, kNoSearch);
+      DisplacementField2 field = mapped_pair(c1, n1, index1, c2, n2, index2, options, &similarity);
+      const double size = (p1.colwise().maxCoeff() - p1.colwise().minCoeff()).norm();
+      keep_points_of(field, p1, 1e-9 * size);
+      if (field.starts.allFinite() && field.ends.allFinite() && crossing_pairs(field.starts, field.ends).empty()) {
+        moved = std::move(field);
+      }
+    } catch (const GeometryError&) {  // the moved pair has no crossing-free field: the plain one stands
+    } catch (const InvalidInput&) {   // the moved C1 is not simple (rounding at a near-touch)
+    }
+  };
+  run_both(run_plain, run_moved);  // the plain pass's InvalidInput (bad options, curves apart) first
   if (!moved) {
     if (plain) return std::move(*plain);
     throw GeometryError(why);
