@@ -92,6 +92,16 @@ def test_map_bad_arguments_exit_2(tmp_path):
         assert run.returncode == 2 and "Traceback" not in run.stderr, args
 
 
+def test_map_refuses_an_unknown_output_suffix_before_mapping(tmp_path):
+    c1, c2 = mm.load_example("kidney")
+    mm.write_curve(tmp_path / "c1.csv", c1)
+    mm.write_curve(tmp_path / "c2.csv", c2)
+    run = morphomap("map", tmp_path / "c1.csv", tmp_path / "c2.csv", "-o", tmp_path / "f.vtk")
+    assert run.returncode == 2 and "Traceback" not in run.stderr
+    assert "-o " in run.stderr and "unknown format '.vtk'" in run.stderr and ".csv" in run.stderr
+    assert not (tmp_path / "f.vtk").exists()
+
+
 def test_map_reads_masks(tmp_path):
     # Two frames of a growing disc as ImageJ TIFFs at 0.5 um per pixel: the command says which
     # spacing it used, writes the field and maps without crossings.

@@ -82,7 +82,13 @@ def _summary(field, q) -> str:
 
 def _map(args, parser) -> int:
     import morphomap
+    from ..io.formats import writer
 
+    if args.output != "-":
+        try:
+            writer(args.output, "field")  # an unknown suffix before the work, not a traceback after it
+        except ValueError as error:
+            parser.error(f"-o {args.output}: {error}")
     c1, c2, from_image, field, q = _read_and_map(args, parser)
     title = f"{args.method}: QM1 {q.qm1:.4g}  QM2 {q.qm2:.4g}  QM {q.qm:.4g}"
     try:
