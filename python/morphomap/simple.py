@@ -53,6 +53,7 @@ import numpy as np
 
 from . import _core
 from ._validate import as_flag, as_points
+from .curves import signed_area
 
 #: How far each visit of a neck point is moved, relative to the median point spacing.
 NECK_OPENING = 1e-6
@@ -178,11 +179,6 @@ def simple_curve(points, closed: bool, name: str):
     return _Repair(p, closed, name).run()
 
 
-def _area(p: np.ndarray) -> float:
-    x, y = p[:, 0], p[:, 1]
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
-
-
 def _turns_back(u, v, q) -> bool:
     """Whether the path u -> v -> q goes back along the segment it came by."""
     d1x, d1y, d2x, d2y = v[0] - u[0], v[1] - u[1], q[0] - v[0], q[1] - v[1]
@@ -208,7 +204,7 @@ class _Repair:
             p = self.fix_seam(p, rows, spacing)
         if _core.is_self_intersecting(p, self.closed):
             self.refuse(p, rows)
-        if self.closed and _area(p) == 0.0:
+        if self.closed and signed_area(p) == 0.0:
             raise ValueError(f"{self.name}: the closed curve encloses zero area once its repeated points and spurs "
                              "are removed; pass the boundary of a region")
         return p, Changes(self.changes, rows)
@@ -290,7 +286,7 @@ class _Repair:
         self.refuse_long_corridors(p, rows, visits, spacing)
         step = NECK_OPENING * spacing
         if self.closed:
-            sides = (1.0 if _area(p) > 0 else -1.0,)
+            sides = (1.0 if signed_area(p) > 0 else -1.0,)
         else:
             sides = (1.0, -1.0)
         for side in sides:
@@ -304,7 +300,7 @@ class _Repair:
         for group in sorted(groups.values()):
             moved = np.linalg.norm(q[group] - p[group], axis=1).max()
             self.changes.append(Change("neck", tuple(int(rows[k]) for k in group), tuple(p[group[0]].tolist()),
-                                       distance=float(moved), area=abs(_area(q) - _area(p)) / len(groups)
+                                       distance=float(moved), area=abs(signed_area(q) - signed_area(p)) / len(groups)
                                        if self.closed else 0.0))
         return q
 
@@ -364,13 +360,13 @@ class _Repair:
         q = p[order]
         # A hair across, not a loop: the sliver between the two orders is a small part of the area
         # (the limb outlines': 1e-4 to 1.4e-3; else the crossing is genuine and refused).
-        sliver = abs(_area(q) - _area(p))
-        if sliver > 1e-2 * abs(_area(q)) or _core.is_self_intersecting(q, True):
+        sliver = abs(signed_area(q) - signed_area(p))
+        if sliver > 1e-2 * abs(signed_area(q)) or _core.is_self_intersecting(q, True):
             return p
         rows[:] = rows[order]
         self.changes.append(Change("first point" if first else "last point", (int(rows[j]), int(rows[k])),
                                    tuple(p[k].tolist()), distance=float(np.linalg.norm(p[k] - p[j])),
-                                   area=abs(_area(q) - _area(p))))
+                                   area=abs(signed_area(q) - signed_area(p))))
         return q
 
     def refuse(self, p: np.ndarray, rows: np.ndarray):

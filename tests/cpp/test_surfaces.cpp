@@ -338,7 +338,7 @@ int main() {
     }
   }
 
-  // Only kSurfaceMethods have a 3D form; the refusal names the method and lists them.
+  // Only the table's 3D methods have a 3D form; the refusal names the method and lists them.
   for (const MapMethod method : {MapMethod::uniform, MapMethod::optimal}) {
     options.method = method;
     try {

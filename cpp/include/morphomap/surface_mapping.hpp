@@ -10,10 +10,6 @@
 
 namespace morphomap {
 
-// The methods map_surfaces takes, in the order users see them listed.
-constexpr MapMethod kSurfaceMethods[] = {MapMethod::automatic, MapMethod::minimal_distance, MapMethod::normal,
-                                         MapMethod::diffusion};
-
 struct SurfaceMappingOptions {
   // minimal_distance: each vertex to its closest point on the target.
   // normal: the line through each vertex along its angle-weighted normal, both directions, to the
@@ -28,7 +24,8 @@ struct SurfaceMappingOptions {
   //   where more than half of the vertices would be redone) reverse diffusion for the whole
   //   surface (rows and faces of the target); where that fails (the region cannot be meshed),
   //   diffusion, then the normal mapping if it missed nothing, then minimal distance.
-  // Only kSurfaceMethods: uniform and optimal have no 3D form (InvalidInput).
+  // Only the methods kMethodTable marks `surfaces`: uniform, optimal and paper have no 3D form
+  // (InvalidInput).
   MapMethod method = MapMethod::normal;
   bool reverse = false;              // map S2 -> S1 and flip: starts on S1, ends on S2, rows and faces of S2
   double diffusion_mesh_size = 0.0;  // ShellDiffusionOptions::mesh_size (0: automatic)

@@ -182,22 +182,9 @@ Points2 basic_ends(MapMethod method, const Job& job, const Points2& starts, cons
 }  // namespace
 
 Method basic_method(MapMethod method) {
-  switch (method) {
-    case MapMethod::minimal_distance:
-      return Method::minimal_distance;
-    case MapMethod::optimal:
-      return Method::optimal;
-    case MapMethod::normal:
-      return Method::normal;
-    case MapMethod::uniform:
-      return Method::uniform;
-    case MapMethod::diffusion:
-      return Method::diffusion;
-    case MapMethod::automatic:
-    case MapMethod::paper:
-      break;
-  }
-  detail::invalid("method", std::string("'") + map_method_name(method) + "' is not a basic algorithm");
+  const MethodRow& row = method_row(method);
+  if (!row.forward) detail::invalid("method", std::string("'") + row.name + "' is not a basic algorithm");
+  return *row.forward;
 }
 
 // A basic algorithm on one job, from its start points.
