@@ -1,5 +1,6 @@
 """The command line: `morphomap info`, `map`, `extend`, `series` and `batch` end to end."""
 
+import os
 import re
 
 import numpy as np
@@ -100,6 +101,9 @@ def test_map_refuses_an_unknown_output_suffix_before_mapping(tmp_path):
     assert run.returncode == 2 and "Traceback" not in run.stderr
     assert "-o " in run.stderr and "unknown format '.vtk'" in run.stderr and ".csv" in run.stderr
     assert not (tmp_path / "f.vtk").exists()
+    # A device is a stream, as "-" is: CSV.
+    run = morphomap("map", tmp_path / "c1.csv", tmp_path / "c2.csv", "-o", os.devnull)
+    assert run.returncode == 0, run.stderr
 
 
 def test_map_reads_masks(tmp_path):

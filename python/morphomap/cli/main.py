@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import warnings
 
@@ -84,7 +85,9 @@ def _map(args, parser) -> int:
     import morphomap
     from ..io.formats import writer
 
-    if args.output != "-":
+    # "-" and a device such as /dev/null are streams: CSV, as to an open text file.
+    stream = args.output == "-" or (os.path.exists(args.output) and not os.path.isfile(args.output))
+    if not stream:
         try:
             writer(args.output, "field")  # an unknown suffix before the work, not a traceback after it
         except ValueError as error:
@@ -92,7 +95,13 @@ def _map(args, parser) -> int:
     c1, c2, from_image, field, q = _read_and_map(args, parser)
     title = f"{args.method}: QM1 {q.qm1:.4g}  QM2 {q.qm2:.4g}  QM {q.qm:.4g}"
     try:
-        morphomap.write_field(sys.stdout if args.output == "-" else args.output, field)
+        if args.output == "-":
+            morphomap.write_field(sys.stdout, field)
+        elif stream:
+            with open(args.output, "w") as device:
+                morphomap.write_field(device, field)
+        else:
+            morphomap.write_field(args.output, field)
         if args.plot:
             from matplotlib.figure import Figure
 
