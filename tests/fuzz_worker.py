@@ -146,6 +146,14 @@ class Worker:
             # on which a basic method answers without crossings or misses must not make it raise.
             result["crossings"] = int(mm.count_crossings(np.asarray(field.starts)[valid],
                                                          np.asarray(field.ends)[valid]))
+        else:
+            # Every 3D field is one of S1's vertices; its folds decide whether a basic method
+            # "answered" (the default must then answer too) and whether the default folded.
+            result["s1_rows"] = bool(len(field) == len(made.arrays(made.s1)[0]))
+            try:
+                result["surface_folds"] = int(mm.quality(field, made.s1, made.s2).folds)
+            except Exception as error:  # noqa: BLE001
+                result["check_error"] = f"quality: {type(error).__name__}: {error}"[:MESSAGE_LIMIT]
         if method not in ("diffusion", "auto"):
             return result
 

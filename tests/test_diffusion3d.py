@@ -237,8 +237,10 @@ def test_a_surface_enclosing_no_volume_is_named_whichever_way_diffusion_runs():
             mm.map_surfaces(flat, ball, "diffusion", reverse=reverse)
     with pytest.raises(ValueError, match="^s1: encloses no volume"):
         mm.solve_diffusion_3d(flat, ball)
-    field = mm.map_surfaces(ball, flat, "auto")  # no diffusion to fall back on: minimal distance
-    assert field.valid.all() and set(field.method) <= {"normal", "minimal_distance"}
+    # No diffusion to fall back on, and normal mapping and minimal distance fold: "auto" says so.
+    with pytest.raises(mm.GeometryError, match=r"^map_surfaces: no complete, fold-free field .*\(normal: .*"
+                                               r"minimal distance: 0 vertices unmapped, \d+ triangles folded"):
+        mm.map_surfaces(ball, flat)
 
 
 def test_a_coarse_inner_sphere_is_as_accurate_by_default():

@@ -16,10 +16,13 @@ Invariants, one test per category and dimension (``test_fuzz_2d[crash]``, ...):
 - ``unnamed_error``: a ValueError / TypeError whose message does not start with the argument's name;
 - ``empty_region``: "the region between the curves is empty" although C1 and C2 differ;
 - ``auto_raised``: ``method="auto"`` raised on a pair where a basic method answered the same way
-  round (plain or reverse; in 2D without crossings or misses, as the default's contract asks);
+  round (plain or reverse; without misses, and in 2D without crossings, in 3D without folds, as
+  the default's contract asks);
   ``auto_raised_raw`` the same on a raw pair (invalid curves or meshes, where the error may be
   right but the rule asks for an answer);
 - ``auto_crossings`` (2D): the default returned crossings or misses (it must raise instead);
+- ``auto_folds`` (3D): the default returned folded triangles or misses (it must raise instead);
+- ``not_s1_field`` (3D): a field that is not one vector per vertex of S1 (every method's is);
 - ``ends_off_target`` / ``starts_off_source``: diffusion and auto ends not on C2 (S2), starts not
   on C1 (S1), within 1e-6 of the curve's (surface's) bounding-box diagonal;
 - ``out_of_order`` (2D diffusion): the ends, in the order of their starts along C1, step back along C2
@@ -118,7 +121,8 @@ CATEGORIES = {
         "auto_raised_raw", "auto_crossings", "ends_off_target", "starts_off_source", "out_of_order", "check_error",
         "harness"),
     3: ("crash", "hang", "unexpected_exception", "unnamed_error", "empty_region", "auto_raised",
-        "auto_raised_raw", "ends_off_target", "starts_off_source", "folds", "check_error", "harness"),
+        "auto_raised_raw", "auto_folds", "not_s1_field", "ends_off_target", "starts_off_source", "folds",
+        "check_error", "harness"),
 }
 
 
@@ -423,6 +427,8 @@ def classify(records):
         if record["method"] in BASIC and record["variant"] in ("plain", "reverse") and record["outcome"] == "ok":
             if record["dim"] == 2 and (record.get("crossings", 0) or record.get("valid") != record.get("vectors")):
                 continue
+            if record["dim"] == 3 and (record.get("surface_folds", 1) or record.get("valid") != record.get("vectors")):
+                continue
             answered[way(record)].append(f"{record['method']}/{record['variant']}")
     for record in records:
         outcome = record["outcome"]
@@ -454,6 +460,12 @@ def classify(records):
                 record.get("crossings", 0) or record.get("valid") != record.get("vectors")):
             failures["auto_crossings"].append(
                 (record, f"{record.get('crossings')} crossing pairs, {record['vectors'] - record['valid']} misses"))
+        if record["method"] == "auto" and record["dim"] == 3 and (
+                record.get("surface_folds", 0) or record.get("valid") != record.get("vectors")):
+            misses = record["vectors"] - record["valid"]
+            failures["auto_folds"].append((record, f"{record.get('surface_folds')} folded triangles, {misses} misses"))
+        if record["dim"] == 3 and record.get("s1_rows") is False:
+            failures["not_s1_field"].append((record, f"{record['vectors']} vectors, not one per vertex of S1"))
         if record.get("far_ends"):
             failures["ends_off_target"].append(
                 (

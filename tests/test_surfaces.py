@@ -248,14 +248,19 @@ def test_minimal_distance_ends_on_the_target(sphere):
     np.testing.assert_array_equal(field.ends, hits.points)
 
 
-def test_reverse_starts_on_s1_in_s2_order(sphere):
+def test_reverse_is_carried_onto_the_vertices_of_s1(sphere):
     v1, f1 = sphere
     v2, f2 = ellipsoid(3)
     field = mm.map_surfaces((v1, f1), (v2, f2), "normal", reverse=True)
-    assert len(field) == len(v2)
-    np.testing.assert_array_equal(field.ends, v2)
-    np.testing.assert_array_equal(field.faces, f2)
-    assert np.abs(np.linalg.norm(field.starts, axis=1) - 1).max() < 0.01  # on the sphere mesh
+    np.testing.assert_array_equal(field.starts, v1)
+    np.testing.assert_array_equal(field.faces, f1)
+    assert field.valid.all() and set(field.method) == {"reverse_normal"}
+    on_s2 = mm.SurfaceIndex(v2, f2).closest_points(field.ends).distances
+    assert on_s2.max() < 1e-9
+    # Concentric spheres of radius 1 and 2 (one mesh scaled): reverse normal mapping takes 2p to
+    # about p, so carried back each vertex p goes to about 2p (the normals are nearly radial).
+    big = mm.map_surfaces((v1, f1), (2 * v1, f1), "normal", reverse=True)
+    assert np.abs(big.ends - 2 * v1).max() < 0.02
 
 
 def test_quality_of_the_identity_and_a_scaling(sphere):
@@ -359,18 +364,19 @@ def test_auto_is_normal_when_it_works(sphere):
 
 def test_auto_falls_back_to_reverse_diffusion_where_normals_miss(sphere):
     # Most normals of a big sphere miss a small one off its centre; "auto" then takes reverse
-    # diffusion: streamlines from the small sphere's vertices back to the big one, turned round.
+    # diffusion (streamlines from the small sphere's vertices back to the big one), carried onto
+    # the big sphere's vertices: one vector each, every one valid, no fold.
     v1, f1 = icosphere(2, radius=3.0)
     v2, f2 = icosphere(2, radius=0.5)
     v2 = v2 + [1.0, 0, 0]
     assert not mm.map_surfaces((v1, f1), (v2, f2), "normal").valid.all()
-    field = mm.map_surfaces((v1, f1), (v2, f2), "auto")
+    field = mm.map_surfaces((v1, f1), (v2, f2))
     assert set(field.method) == {"reverse_diffusion"}
-    assert len(field) == len(v2)
-    np.testing.assert_array_equal(field.faces, f2)
-    valid = field.valid
-    assert valid.mean() > 0.9
-    np.testing.assert_array_equal(field.ends[valid], v2[valid])
+    np.testing.assert_array_equal(field.starts, v1)
+    np.testing.assert_array_equal(field.faces, f1)
+    assert field.valid.all()
+    assert mm.quality(field, (v1, f1), (v2, f2)).folds == 0
+    assert mm.SurfaceIndex(v2, f2).closest_points(field.ends).distances.max() < 1e-9
 
 
 def test_auto_diffuses_only_near_a_new_bud_where_normal_mapping_folds():
@@ -734,3 +740,22 @@ def test_many_lines_on_a_large_surface_in_any_order(rng):
     assert np.array_equal(np.isnan(hits.distances[pick]), np.isnan(expected))
     found = ~np.isnan(expected)
     assert np.abs(np.abs(hits.distances[pick][found]) - np.abs(expected[found])).max() <= 1e-9 * 4.0
+
+
+@pytest.mark.parametrize("method", ["auto", "diffusion"])
+def test_a_crossing_ellipsoid_is_mapped_complete_and_fold_free(method):
+    # A unit sphere and an ellipsoid (1.4, 0.8, 0.8) cross along two circles: the poles of S1 lie
+    # inside S2, its waist outside. Each region between them is mapped on its own; the field is
+    # one of S1's vertices with every vertex mapped, ends on S2, no fold, and (diffusion) the
+    # poles move outwards along x, the waist inwards.
+    v1, f1 = icosphere(3, radius=1.0)
+    v2, f2 = icosphere(3, radius=1.0)
+    v2 = v2 * [1.4, 0.8, 0.8]
+    field = mm.map_surfaces((v1, f1), (v2, f2), method)
+    np.testing.assert_array_equal(field.starts, v1)
+    assert field.valid.all()
+    assert mm.quality(field, (v1, f1), (v2, f2)).folds == 0
+    assert mm.SurfaceIndex(v2, f2).closest_points(field.ends).distances.max() < 1e-9
+    radial = np.einsum("ij,ij->i", field.vectors, v1)
+    poles, waist = np.abs(v1[:, 0]) > 0.95, np.abs(v1[:, 0]) < 0.05
+    assert (radial[poles] > 0).all() and (radial[waist] < 0).all()

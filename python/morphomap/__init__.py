@@ -41,7 +41,7 @@ from .batch import Job, map_batch
 from .series import Series, map_series
 from .simple import make_simple
 from .queries import CurveHits, CurveIndex, closest_points, line_intersections
-from .surfaces import PreparedSurface, SurfaceHits, SurfaceIndex, map_surfaces, surface_normals
+from .surfaces import PreparedSurface, SurfaceHits, SurfaceIndex, map_surfaces, remesh_surface, surface_normals
 from .transform import Similarity, align_curves, overlap_area
 
 __version__ = _build_info()["version"]
@@ -99,6 +99,7 @@ __all__ = [
     "read_field",
     "read_image",
     "read_surface",
+    "remesh_surface",
     "resample",
     "signed_area",
     "solve_diffusion",

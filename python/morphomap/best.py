@@ -46,6 +46,7 @@ from __future__ import annotations
 import math
 import os
 import time
+import warnings
 from concurrent.futures import ThreadPoolExecutor
 from typing import NamedTuple
 
@@ -150,7 +151,13 @@ def _pick(results, piece_rows=None):
     if not ran:
         reasons = "; ".join(f"{c.name}: {c.status}" for _, c in results)
         raise ValueError(f"method 'best': no candidate could map this pair ({reasons})")
-    winner = min(ran, key=lambda fc: _key(fc[1]))[1].name
+    best = min(ran, key=lambda fc: _key(fc[1]))[1]
+    winner = best.name
+    if best.defects or best.misses:
+        # Every candidate has defects: the least bad is returned, but never silently.
+        warnings.warn(f"method 'best': every candidate has defects (crossing pairs in 2D, folded triangles in "
+                      f"3D) or misses; {winner} has {best.defects} and {best.misses} (see field.candidates)",
+                      UserWarning, stacklevel=4)
     table = [c._replace(status="won") if c.name == winner else c for _, c in results]
     field = next(f for f, c in ran if c.name == winner)
     return field._with_candidates(table, piece_rows)

@@ -8,7 +8,7 @@ import numpy as np
 
 from . import _core
 from ._progress import StageBar, as_progress
-from ._validate import as_choice, as_faces, as_flag, as_points, as_real
+from ._validate import as_choice, as_faces, as_flag, as_integer, as_points, as_real
 from .field import DisplacementField
 
 #: What ``method`` takes: the methods with a 3D form in the core's method table, then ``"best"``,
@@ -120,7 +120,39 @@ def surface_normals(vertices, faces) -> np.ndarray:
     return _core.vertex_normals(vertices, as_faces(faces, "faces", len(vertices)))
 
 
-def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None, repeatable=True,
+def remesh_surface(surface, edge_length, *, iterations=3):
+    """The same closed surface with near-uniform triangles of edge length about ``edge_length``.
+
+    CGAL's isotropic remeshing in the C++ core (edge splits, collapses, flips and tangential
+    relaxation, every new vertex projected back onto the input), as :func:`surface_from_mask`
+    uses; for coarse surfaces with long thin triangles, such as an open surface closed by a flat
+    cap. ``map_surfaces`` refines such input itself for diffusion (see its ``method``); remesh
+    first to have the field on the even vertices.
+
+    Parameters
+    ----------
+    surface : trimesh.Trimesh or (vertices (V, 3) float, faces (F, 3) int)
+        Closed, manifold, one piece; zero-area faces are removed first. The orientation is kept.
+    edge_length : float
+        Target edge length, in the surface's units (> 0).
+    iterations : int
+        Remeshing rounds (>= 1); three bring the smallest angles above 20 degrees on contoured masks.
+
+    Returns
+    -------
+    trimesh.Trimesh
+    """
+    import trimesh
+
+    vertices, faces = as_surface(surface, "surface")
+    if edge_length is None:
+        raise TypeError("edge_length: expected a positive number, got None")
+    remeshed = _core.remesh_surface(vertices, faces, as_real(edge_length, "edge_length", 0.0),
+                                    as_integer(iterations, "iterations", 3))
+    return trimesh.Trimesh(remeshed["vertices"], remeshed["faces"], process=False)
+
+
+def map_surfaces(s1, s2, method="auto", *, reverse=False, mesh_size=None, repeatable=True,
                  skip_below=None, workers=None, progress=None) -> DisplacementField:
     """Map closed surface ``s1`` (time t) onto closed surface ``s2`` (time t + dt).
 
@@ -130,7 +162,7 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None, repe
         Closed, consistently oriented triangle surfaces: every edge used by exactly two faces in
         opposite directions, finite coordinates, no zero-area face. Two :class:`PreparedSurface`
         skip the checks and index building they have done once.
-    method : {"normal", "minimal_distance", "diffusion", "auto", "best"}
+    method : {"auto", "normal", "minimal_distance", "diffusion", "best"}
         ``"minimal_distance"``: each vertex of ``s1`` to its closest point on ``s2``.
         ``"normal"``: the line through each vertex along its angle-weighted normal, both
         directions, to its nearest intersection with ``s2``; NaN where it meets nothing.
@@ -143,24 +175,25 @@ def map_surfaces(s1, s2, method="normal", *, reverse=False, mesh_size=None, repe
         narrower than the mesh's distance to the surfaces: the ends of such triangles are moved
         into the kernel of their image fan on S2 (a few tenths of an edge at most in the fuzz
         suite), so that the field has no folds where that succeeds; ``quality`` counts any left.
-        ``"auto"``: normal mapping; if a normal misses or a triangle's image is turned over (see
-        :func:`quality`, ``folds``) and the surfaces are nested, the normal field is kept except
-        within two mean gaps (the volume between the surfaces over their mean area) of those
-        vertices: there diffusion, whose mesh is fine only near them, with its ends blended
-        into the normal ones across the outer gap and projected onto ``s2`` (``field.method``:
-        ``"diffusion"`` there, ``"normal"`` elsewhere; the field starts from the vertices of
-        ``s1``). Where that leaves a fold or loses a streamline, where more than half of ``s1``
-        would be redone, or where the surfaces cross, reverse diffusion for the whole surface
-        instead (the field then starts from the vertices of ``s2``; ``field.method`` tells).
-        On a lumpy pair of 100k faces with one new bud this is several times faster than
-        diffusion over the whole surface (bench/README.md).
+        ``"auto"`` (the default): a field of every vertex of ``s1`` with no folded triangle (see
+        :func:`quality`, ``folds``), or :class:`GeometryError` saying how many vertices each way
+        left unmapped and how many triangles folded, and where; never a folded field. Tried in
+        turn, the first such field returned: normal mapping; between nested surfaces the normal
+        field with diffusion within two mean gaps of where it failed (its ends blended into the
+        normal ones and put on ``s2``); reverse diffusion carried onto ``s1``'s vertices (the
+        paper's choice); diffusion; minimal distance. A diffusion field with a few folded
+        triangles left has the ends around them (up to 4 edges away) re-placed by the harmonic
+        interpolation of the ends around, put on ``s2``, if that leaves no fold.
+        ``field.method`` says which way each vector came.
         ``"best"`` (beyond the paper): normal, minimal distance and diffusion, each plain and
         reversed, and ``"auto"``; the one without folds or misses of lowest QM, with the table
         of them all in ``field.candidates`` (:func:`morphomap.best.map_best_surfaces`). The pair
         of surfaces is one subproblem: the choice is per pair, not per piece as in 2D.
     reverse : bool
-        Map S2 -> S1 with the chosen algorithm and flip the vectors: starts lie on S1, ends on S2,
-        in the order of S2's vertices, and ``field.faces`` are S2's faces.
+        Map S2 -> S1 with the chosen algorithm and carry the result onto S1's vertices: each vertex
+        of S1 is located on the image of S2's triangles, and its end is the point of S2's triangle
+        with the same barycentric coordinates (NaN where the reversed field left a hole there).
+        As every field of this function, one vector per vertex of S1 in its order, with S1's faces.
     mesh_size : float, optional
         The tetrahedral mesh of diffusion mapping (also within ``"auto"``), as in
         :func:`solve_diffusion_3d`.

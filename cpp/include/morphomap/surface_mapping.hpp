@@ -16,32 +16,35 @@ struct SurfaceMappingOptions {
   //   nearest intersection with the target; NaN where it meets nothing.
   // diffusion: streamlines of Laplace's equation between the surfaces (solve_diffusion_3d); the
   //   ends are put onto their closest point of the target (the tetrahedral mesh only
-  //   approximates it).
-  // automatic: normal mapping; if it misses anywhere or folds a triangle (count_folds), between
-  //   nested surfaces diffusion for the vertices within two mean gaps of those places (the mesh
-  //   coarser away from them), its ends blended into the normal ones over the outer gap, the
-  //   rest of the normal field kept (methods: normal, diffusion), if that has no fold; else (or
-  //   where more than half of the vertices would be redone) reverse diffusion for the whole
-  //   surface (rows and faces of the target); where that fails (the region cannot be meshed),
-  //   diffusion, then the normal mapping if it missed nothing, then minimal distance.
+  //   approximates it). A lost streamline takes the harmonic interpolation of its neighbours'
+  //   ends, put on the target. A surface with a corner angle below 3 degrees (the flat caps of
+  //   long thin triangles that close open surfaces) is refined for diffusion by isotropic
+  //   remeshing with its vertices held; the field is reported on its own vertices.
+  // automatic (the default): every vertex of S1 mapped and no triangle folded (count_folds), or
+  //   GeometryError naming, for each way tried, how many vertices it left unmapped and how many
+  //   triangles folded, and where. Tried in turn: normal mapping; between nested surfaces, the
+  //   normal field with diffusion within two mean gaps of where it failed; reverse diffusion
+  //   carried onto S1's vertices; diffusion (each diffusion with the ends around its last folds
+  //   re-placed by harmonic interpolation where that removes them); minimal distance.
   // Only the methods kMethodTable marks `surfaces`: uniform, optimal and paper have no 3D form
   // (InvalidInput).
-  MapMethod method = MapMethod::normal;
-  bool reverse = false;              // map S2 -> S1 and flip: starts on S1, ends on S2, rows and faces of S2
+  MapMethod method = MapMethod::automatic;
+  // Map S2 -> S1, then carry that field onto S1's vertices: each vertex located on the image of
+  // S2's triangles, its end the point of S2's triangle with the same barycentric coordinates.
+  bool reverse = false;
   double diffusion_mesh_size = 0.0;  // ShellDiffusionOptions::mesh_size (0: automatic)
   bool diffusion_repeatable = true;  // ShellDiffusionOptions::repeatable
   // Called with the name of each stage as it begins, on the calling thread (a progress report);
   // may be empty. diffusion: "mesh", "solve", "trace" (ShellDiffusionOptions::on_stage).
   // automatic: "normal", then, if it falls back, those three for each diffusion it tries (local,
-  // whole-surface reverse, then forward: they can come up to three times). The other methods
+  // reverse, then forward: they can come up to three times). The other methods
   // report nothing.
   std::function<void(const char* stage)> on_stage;
 };
 
-// Both surfaces must pass check_closed_surface (named "s1" and "s2"). Start points are the
-// vertices of the source surface (S1, or S2 when reversed), in its order; field.faces are its
-// faces. A vector that found nothing keeps its known point: NaN ends on forward vectors, NaN
-// starts on reverse ones (methods then name reverse_ variants).
+// Both surfaces must pass check_closed_surface (named "s1" and "s2"). Every method, either way
+// round, returns one vector per vertex of S1, in its order, with S1's faces; a vertex that found
+// nothing has NaN ends (methods name reverse_ variants when reversed).
 DisplacementField3 map_surfaces(const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2,
                                 const SurfaceMappingOptions& options = {});
 

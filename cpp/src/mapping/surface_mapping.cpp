@@ -4,12 +4,15 @@
 #include <morphomap/surface_mapping.hpp>
 #include <morphomap/surface_queries.hpp>
 
+#include "common/numbers.hpp"
 #include "common/run_both.hpp"
 #include "common/validation.hpp"
 #include "diffusion/shell_diffusion.hpp"
 #include "diffusion/shell_mesh.hpp"
 #include "mapping/local_diffusion.hpp"
+#include "mapping/surface_fields.hpp"
 #include "quality/folds.hpp"
+#include "surfaces/refine.hpp"
 
 #include <morphomap/errors.hpp>
 
@@ -84,6 +87,9 @@ DisplacementField3 basic(MapMethod method, const Pair& pair, const SurfaceIndex&
       if (solution.ends.rows() != field.size())
         throw GeometryError("diffusion: the solver returned the wrong number of ends");
       field.ends = solution.ends;  // on the target itself (solve_diffusion_3d puts them there)
+      // A streamline the tracer loses (it stalls against a sharp crease of the source, such as
+      // the rim of a flat cap, bench/README.md "Real 3D stages") takes its neighbours' ends.
+      detail::fill_lost_ends(field, target_index);
       // The streamlines do not cross; the few slivers their discrete form flips are repaired.
       std::unique_ptr<SurfaceIndex> own_index;
       if (source_index == nullptr) {
@@ -117,64 +123,188 @@ DisplacementField3 flipped(DisplacementField3 field) {
   return field;
 }
 
-bool complete(const DisplacementField3& field) {
-  for (Index i = 0; i < field.size(); ++i) {
-    if (!field.valid(i)) return false;
-  }
-  return true;
-}
-
-// "auto": normal mapping where it misses nothing and folds no triangle; else, between nested
-// surfaces, the normal field with diffusion near where it failed (local_diffusion.hpp); else
-// reverse diffusion over the whole surface (the paper's choice), else diffusion (both fold-free
-// by construction), else the normal mapping if it missed nothing, else minimal distance (which
-// always finds a point): it answers wherever a basic algorithm does.
-DisplacementField3 automatic(const Pair& pair, const SurfaceIndex& target_index,
-                             const ShellDiffusionOptions& diffusion) {
+// `field`, mapped from the vertices of pair.target onto pair.source, as the field of the source's
+// vertices it defines (surface_fields.hpp), its holes filled and its folds repaired as diffusion's
+// are: every method's field is one of S1's vertices, in S1's order.
+DisplacementField3 carried(const DisplacementField3& backwards, const Pair& pair, const SurfaceIndex& source_index,
+                           const SurfaceIndex& target_index) {
   const Surface& source = pair.source;
   const Surface& target = pair.target;
+  DisplacementField3 field = detail::carried_onto_source(flipped(backwards), source.vertices, source.faces);
+  detail::fill_lost_ends(field, target_index);
+  detail::unfold(field.starts, field.ends, field.faces, source.vertices, source.faces, source_index, target.vertices,
+                 target.faces, target_index);
+  return field;
+}
+
+// What is wrong with a candidate of "auto": vertices without an end and folded triangles.
+struct Defects {
+  Index unmapped = 0, folded = 0;
+  Eigen::RowVector3d where = Eigen::RowVector3d::Zero();  // the mean of the start points concerned
+  bool none() const { return unmapped == 0 && folded == 0; }
+  Index total() const { return unmapped + folded; }
+};
+
+Defects defects(const DisplacementField3& field, const detail::FoldTest& test) {
+  Defects d;
+  std::vector<char> concerned(static_cast<std::size_t>(field.size()), 0);
+  for (Index i = 0; i < field.size(); ++i) {
+    if (!field.valid(i)) concerned[static_cast<std::size_t>(i)] = 1, ++d.unmapped;
+  }
+  const std::vector<char> folded = test.folded(field.ends);
+  for (Index k = 0; k < field.faces.rows(); ++k) {
+    if (!folded[static_cast<std::size_t>(k)]) continue;
+    ++d.folded;
+    for (int j = 0; j < 3; ++j) concerned[static_cast<std::size_t>(field.faces(k, j))] = 1;
+  }
+  Index count = 0;
+  for (Index i = 0; i < field.size(); ++i) {
+    if (concerned[static_cast<std::size_t>(i)] && field.starts.row(i).allFinite())
+      d.where += field.starts.row(i), ++count;
+  }
+  if (count > 0) d.where /= static_cast<double>(count);
+  return d;
+}
+
+// The surfaces of one call in one direction: the user's, and the pair diffusion runs on — the
+// user's, or copies whose poor triangles are refined with the user's vertices kept as their
+// first rows (surfaces/refine.hpp: diffusion traces from long thin triangles badly, bench/README.md
+// "Real 3D stages"). With each surface's query index.
+struct Work {
+  Pair user, refined;
+  const SurfaceIndex *user_source, *user_target, *refined_source, *refined_target;
+  bool is_refined;
+  Work swapped() const {
+    return Work{user.swapped(), refined.swapped(), user_target, user_source,
+                refined_target, refined_source,    is_refined};
+  }
+};
+
+// A field of the refined source's vertices as one of the user's: the user's vertices are its
+// first rows; their ends put on the user's target (they lie on the refined copy, whose vertices
+// lie on it), the folds this leaves repaired as diffusion's are.
+DisplacementField3 restricted(const DisplacementField3& refined, const Work& work) {
+  const Surface& source = work.user.source;
+  const Surface& target = work.user.target;
+  const Index n = source.vertices.rows();
+  DisplacementField3 field;
+  field.starts = source.vertices;
+  field.faces = source.faces;
+  field.methods.assign(refined.methods.begin(), refined.methods.begin() + n);
+  field.ends = refined.ends.topRows(n);
+  const SurfaceHits on_target = work.user_target->closest_points(field.ends);
+  for (Index i = 0; i < n; ++i) {
+    if (field.ends.row(i).allFinite()) field.ends.row(i) = on_target.points.row(i);
+  }
+  detail::fill_lost_ends(field, *work.user_target);
+  detail::unfold(field.starts, field.ends, field.faces, source.vertices, source.faces, *work.user_source,
+                 target.vertices, target.faces, *work.user_target);
+  return field;
+}
+
+// Diffusion from the source's vertices (backwards: from the target's, carried onto the source's)
+// on the work pair, as a field of the user's source vertices.
+DisplacementField3 diffusion_field(const Work& work, bool backwards, const ShellDiffusionOptions& diffusion) {
+  const Pair& pair = work.refined;
+  const SurfaceIndex& source_index = *work.refined_source;
+  const SurfaceIndex& target_index = *work.refined_target;
+  DisplacementField3 field =
+      backwards ? carried(basic(MapMethod::diffusion, pair.swapped(), source_index, diffusion, &target_index), pair,
+                          source_index, target_index)
+                : basic(MapMethod::diffusion, pair, target_index, diffusion, &source_index);
+  return work.is_refined ? restricted(field, work) : field;
+}
+
+// `field` with the ends around its folded triangles (within 0 to kSmoothingRings edges of them)
+// re-placed by fill_lost_ends — the harmonic interpolation of the ends around them, put on S2 —
+// the first ring that leaves no fold, or nothing. The folds that diffusion's discrete streamlines
+// and unfold leave are a few triangles wide (bench/README.md "Real 3D stages").
+constexpr int kSmoothingRings = 4;
+std::optional<DisplacementField3> smoothed_over_folds(const DisplacementField3& field, const detail::FoldTest& test,
+                                                      const SurfaceIndex& target_index) {
+  const std::vector<char> folded = test.folded(field.ends);
+  for (int rings = 0; rings <= kSmoothingRings; ++rings) {
+    DisplacementField3 trial = field;
+    for (const Index i : detail::rows_near(field, folded, rings)) trial.ends.row(i).setConstant(detail::kNaN);
+    detail::fill_lost_ends(trial, target_index);
+    if (defects(trial, test).none()) return trial;
+  }
+  return std::nullopt;
+}
+
+// "auto": one vector per vertex of S1, every one mapped and no triangle folded, or GeometryError.
+// Tried in turn, the first such field returned: normal mapping; between nested surfaces, the
+// normal field with diffusion near where it failed (local_diffusion.hpp); reverse diffusion
+// carried onto S1's vertices (the paper's choice where normal mapping fails); diffusion; minimal
+// distance. Diffusion's lost streamlines are filled and its turned slivers repaired within each.
+DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diffusion) {
+  const Pair& pair = work.user;
+  const Surface& source = pair.source;
+  const Surface& target = pair.target;
+  const SurfaceIndex& source_index = *work.user_source;
+  const SurfaceIndex& target_index = *work.user_target;
   if (diffusion.on_stage) diffusion.on_stage("normal");
   DisplacementField3 normal = basic(MapMethod::normal, pair, target_index, diffusion);
-  std::unique_ptr<SurfaceIndex> built;
-  const SurfaceIndex& source_index = index_of(source, built);
-  const bool missed = !complete(normal);
-  const std::vector<char> folded = detail::FoldTest(normal.starts, normal.faces, source.vertices, source.faces,
-                                                    source_index, target.vertices, target.faces, target_index)
-                                       .folded(normal.ends);
-  if (!missed && std::find(folded.begin(), folded.end(), 1) == folded.end()) return normal;
+  const detail::FoldTest test(source.vertices, source.faces, source.vertices, source.faces, source_index,
+                              target.vertices, target.faces, target_index);
+  const Defects normal_defects = defects(normal, test);
+  if (normal_defects.none()) return normal;
+  std::vector<std::pair<std::string, Defects>> tried{{"normal", normal_defects}};
   // Diffusion needs a region between the surfaces; where one of them encloses no volume the
   // attempts would be refused (require_volume), so they are not made.
   const bool diffusable = detail::encloses_volume(source.volume, source.vertices) &&
                           detail::encloses_volume(target.volume, target.vertices);
   if (diffusable && pair.nesting != detail::Nesting::crossing) {
     try {
+      const std::vector<char> folded = test.folded(normal.ends);
       std::optional<DisplacementField3> field =
           detail::normal_with_local_diffusion(normal, folded, shell_pair(pair, target_index), source_index, diffusion);
-      if (field) return std::move(*field);
+      if (field && defects(*field, test).none()) return std::move(*field);
     } catch (const GeometryError&) {
     } catch (const InvalidInput&) {  // surfaces whose region diffusion cannot mesh (they coincide in part, say)
     }
   }
   for (const bool backwards : {true, false}) {
     if (!diffusable) break;
+    const char* name = backwards ? "reverse diffusion" : "diffusion";
     try {
-      DisplacementField3 field =
-          backwards ? flipped(basic(MapMethod::diffusion, pair.swapped(), source_index, diffusion, &target_index))
-                    : basic(MapMethod::diffusion, pair, target_index, diffusion, &source_index);
-      if (complete(field)) return field;
-    } catch (const GeometryError&) {
-    } catch (const InvalidInput&) {  // surfaces whose region diffusion cannot mesh (they coincide in part, say)
+      DisplacementField3 field = diffusion_field(work, backwards, diffusion);
+      const Defects found = defects(field, test);
+      if (found.none()) return field;
+      if (found.unmapped == 0) {
+        if (std::optional<DisplacementField3> smoothed = smoothed_over_folds(field, test, target_index))
+          return *smoothed;
+      }
+      tried.emplace_back(name, found);
+    } catch (const GeometryError& error) {
+      tried.emplace_back(std::string(name) + " (" + error.what() + ")", Defects{-1, -1});
+    } catch (const InvalidInput& error) {
+      tried.emplace_back(std::string(name) + " (" + error.what() + ")", Defects{-1, -1});
     }
   }
-  if (!missed) return normal;
-  return basic(MapMethod::minimal_distance, pair, target_index, diffusion);
+  DisplacementField3 nearest = basic(MapMethod::minimal_distance, pair, target_index, diffusion);
+  const Defects nearest_defects = defects(nearest, test);
+  if (nearest_defects.none()) return nearest;
+  tried.emplace_back("minimal distance", nearest_defects);
+  std::string message = "map_surfaces: no complete, fold-free field from the " +
+                        std::to_string(source.vertices.rows()) + " vertices of s1 to s2 (";
+  for (std::size_t k = 0; k < tried.size(); ++k) {
+    const auto& [name, found] = tried[k];
+    message += (k > 0 ? "; " : "") + name;
+    if (found.unmapped < 0) continue;
+    message += ": " + std::to_string(found.unmapped) + " vertices unmapped, " + std::to_string(found.folded) +
+               " triangles folded around (" + std::to_string(found.where.x()) + ", " + std::to_string(found.where.y()) +
+               ", " + std::to_string(found.where.z()) + ")";
+  }
+  throw GeometryError(message +
+                      "); remesh the surfaces finer and more evenly (remesh_surface), or choose a method and "
+                      "inspect quality(field).folds");
 }
 
-DisplacementField3 directed(MapMethod method, const Pair& pair, const ShellDiffusionOptions& diffusion) {
-  std::unique_ptr<SurfaceIndex> built;
-  const SurfaceIndex& target_index = index_of(pair.target, built);
-  if (method == MapMethod::automatic) return automatic(pair, target_index, diffusion);
-  return basic(method, pair, target_index, diffusion, pair.source.index);
+DisplacementField3 directed(MapMethod method, const Work& work, const ShellDiffusionOptions& diffusion) {
+  if (method == MapMethod::automatic) return automatic(work, diffusion);
+  if (method == MapMethod::diffusion) return diffusion_field(work, false, diffusion);
+  return basic(method, work.user, *work.user_target, diffusion, work.user_source);
 }
 
 // `surface`'s CGAL form: its own (PreparedSurface), else one converted into `built`.
@@ -182,6 +312,61 @@ const detail::ClosedSurface& closed_of(const Surface& surface, std::unique_ptr<c
   if (surface.closed != nullptr) return *surface.closed;
   built = std::make_unique<const detail::ClosedSurface>(surface.vertices, surface.faces);
   return *built;
+}
+
+double median_edge(const Points3Ref& vertices, const FacesRef& faces) {
+  std::vector<double> lengths;
+  lengths.reserve(static_cast<std::size_t>(3 * faces.rows()));
+  for (Index k = 0; k < faces.rows(); ++k) {
+    for (int j = 0; j < 3; ++j)
+      lengths.push_back((vertices.row(faces(k, j)) - vertices.row(faces(k, (j + 1) % 3))).norm());
+  }
+  std::nth_element(lengths.begin(), lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2), lengths.end());
+  return lengths[lengths.size() / 2];
+}
+
+// A surface with poor triangles refined at its median edge length (or half of it), keeping its vertices (what
+// `refined` points at, its CGAL form in `closed`), else the surface itself.
+struct Refined {
+  TriangleSurface mesh;
+  std::unique_ptr<const detail::ClosedSurface> closed;
+  std::unique_ptr<SurfaceIndex> index;
+};
+Surface refined_surface(const Surface& surface, Refined& refined) {
+  if (!detail::has_poor_triangles(surface.vertices, surface.faces)) return surface;
+  // Held vertices close to a thin triangle's far side can make the remeshed surface touch
+  // itself at the median edge length; half of it resolves them.
+  const double edge = median_edge(surface.vertices, surface.faces);
+  try {
+    refined.mesh = detail::refined_keeping_vertices(surface.vertices, surface.faces, edge);
+  } catch (const GeometryError&) {
+    refined.mesh = detail::refined_keeping_vertices(surface.vertices, surface.faces, 0.5 * edge);
+  }
+  refined.closed = std::make_unique<const detail::ClosedSurface>(refined.mesh.vertices, refined.mesh.faces);
+  refined.index = std::make_unique<SurfaceIndex>(refined.mesh.vertices, refined.mesh.faces);
+  const double volume = check_closed_surface(refined.mesh.vertices, refined.mesh.faces, "refined surface");
+  return Surface{refined.mesh.vertices, refined.mesh.faces, volume, refined.index.get(), refined.closed.get()};
+}
+
+// The work pair of `user` (whose surfaces have their index and CGAL form): refined copies where a
+// surface's triangles are poor and both enclose volume, else the user's own.
+Work work_pair(const Pair& user, Refined& refined1, Refined& refined2) {
+  const Surface& s1 = user.source;
+  const Surface& s2 = user.target;
+  const Work plain{user, user, s1.index, s2.index, s1.index, s2.index, false};
+  if (!detail::encloses_volume(s1.volume, s1.vertices) || !detail::encloses_volume(s2.volume, s2.vertices))
+    return plain;
+  std::optional<Surface> r1, r2;
+  try {
+    detail::run_both([&] { r1.emplace(refined_surface(s1, refined1)); },
+                     [&] { r2.emplace(refined_surface(s2, refined2)); });
+  } catch (const GeometryError&) {  // a refinement that would intersect itself: diffusion on the user's
+    return plain;
+  }
+  if (!refined1.closed && !refined2.closed) return plain;
+  const detail::Nesting nesting = detail::classify_nesting(*r1->closed, *r2->closed);
+  if (nesting == detail::Nesting::disjoint) return plain;
+  return Work{user, Pair{*r1, *r2, nesting}, s1.index, s2.index, r1->index, r2->index, true};
 }
 
 // map_surfaces on two checked surfaces: each converted to CGAL's form and tested for
@@ -210,9 +395,15 @@ DisplacementField3 checked(Surface s1, Surface s2, const SurfaceMappingOptions& 
   diffusion.mesh_size = options.diffusion_mesh_size;
   diffusion.repeatable = options.diffusion_repeatable;
   diffusion.on_stage = options.on_stage;
-  const Pair pair{s1, s2, nesting};
-  if (!options.reverse) return directed(options.method, pair, diffusion);
-  return flipped(directed(options.method, pair.swapped(), diffusion));
+  std::unique_ptr<SurfaceIndex> index_built1, index_built2;
+  detail::run_both([&] { s1.index = &index_of(s1, index_built1); }, [&] { s2.index = &index_of(s2, index_built2); });
+  const Pair user{s1, s2, nesting};
+  Refined refined1, refined2;
+  const bool diffuses = options.method == MapMethod::diffusion || options.method == MapMethod::automatic;
+  const Work work =
+      diffuses ? work_pair(user, refined1, refined2) : Work{user, user, s1.index, s2.index, s1.index, s2.index, false};
+  if (!options.reverse) return directed(options.method, work, diffusion);
+  return carried(directed(options.method, work.swapped(), diffusion), user, *s1.index, *s2.index);
 }
 
 }  // namespace

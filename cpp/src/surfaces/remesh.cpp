@@ -6,6 +6,7 @@
 
 #include "common/interrupt_check.hpp"
 #include "common/validation.hpp"
+#include "surfaces/refine.hpp"
 #include "surfaces/surface_mesh.hpp"
 #include "surfaces/surface_util.hpp"
 
@@ -19,6 +20,7 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 namespace morphomap {
 
@@ -84,6 +86,71 @@ TriangleSurface remesh_surface(const Points3Ref& vertices, const FacesRef& trian
 
   TriangleSurface out;
   detail::from_surface_mesh(mesh, out.vertices, out.faces);
+  return out;
+}
+
+bool detail::has_poor_triangles(const Points3Ref& vertices, const FacesRef& faces) {
+  const double limit = std::cos(kPoorAngleDegrees * 3.14159265358979323846 / 180.0);
+  for (Index k = 0; k < faces.rows(); ++k) {
+    for (int j = 0; j < 3; ++j) {
+      const Eigen::RowVector3d corner = vertices.row(faces(k, j));
+      const Eigen::RowVector3d a = vertices.row(faces(k, (j + 1) % 3)) - corner;
+      const Eigen::RowVector3d b = vertices.row(faces(k, (j + 2) % 3)) - corner;
+      const double na = a.norm(), nb = b.norm();
+      if (na > 0.0 && nb > 0.0 && a.dot(b) / (na * nb) > limit) return true;
+    }
+  }
+  return false;
+}
+
+TriangleSurface detail::refined_keeping_vertices(const Points3Ref& vertices, const FacesRef& faces,
+                                                 double edge_length) {
+  detail::SurfaceMesh mesh = detail::to_surface_mesh(vertices, faces);
+  using Vertex = detail::SurfaceMesh::Vertex_index;
+  auto kept = mesh.add_property_map<Vertex, bool>("v:kept", false).first;
+  auto original = mesh.add_property_map<Vertex, Index>("v:original", -1).first;
+  // to_surface_mesh adds the vertices that faces use, in their order.
+  const Index count = vertices.rows();
+  std::vector<char> used(static_cast<std::size_t>(count), 0);
+  for (Index k = 0; k < faces.rows(); ++k) {
+    for (int j = 0; j < 3; ++j) used[static_cast<std::size_t>(faces(k, j))] = 1;
+  }
+  Index input_row = 0;
+  for (const Vertex v : mesh.vertices()) {
+    while (!used[static_cast<std::size_t>(input_row)]) ++input_row;
+    kept[v] = true;
+    original[v] = input_row++;
+  }
+  // Three rounds, as surface_from_mask's (REMESH_ROUNDS), in one call (see remesh_surface).
+  PMP::isotropic_remeshing(CGAL::faces(mesh), edge_length, mesh,
+                           CGAL::parameters::number_of_iterations(3).vertex_is_constrained_map(kept));
+  detail::check_interrupt();
+  if (PMP::does_self_intersect<CGAL::Parallel_if_available_tag>(mesh)) {
+    throw GeometryError("surface: refining its triangles at edge length " + std::to_string(edge_length) +
+                        " makes it intersect itself");
+  }
+  mesh.collect_garbage();
+  TriangleSurface out;
+  Index unused = 0;
+  for (const char u : used) unused += u ? 0 : 1;
+  out.vertices.resize(static_cast<Index>(mesh.number_of_vertices()) + unused, 3);
+  out.vertices.topRows(count) = vertices;  // the unused rows too
+  std::vector<Index> row(mesh.num_vertices(), -1);
+  Index next = count;
+  for (const Vertex v : mesh.vertices()) {
+    const Index r = original[v] >= 0 ? original[v] : next++;
+    row[v.idx()] = r;
+    const auto& p = mesh.point(v);
+    out.vertices.row(r) << p.x(), p.y(), p.z();
+  }
+  if (next != out.vertices.rows()) throw GeometryError("surface: refining its triangles lost one of its vertices");
+  out.faces.resize(static_cast<Index>(mesh.number_of_faces()), 3);
+  Index k = 0;
+  for (const auto f : mesh.faces()) {
+    int j = 0;
+    for (const Vertex v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) out.faces(k, j++) = row[v.idx()];
+    ++k;
+  }
   return out;
 }
 

@@ -1,0 +1,101 @@
+"""The mouse limb bud's surfaces at 250, 270 and 290 h (../shared/cases/limb-bud/3d, read its
+README): coarse, closed by flat caps of long thin triangles, and 270/290 cross near the flank.
+The default ("auto") returns every vertex of S1 mapped with no folded triangle, or raises
+GeometryError saying how each way failed; every method returns one vector per vertex of S1."""
+
+import os
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import morphomap as mm
+
+trimesh = pytest.importorskip("trimesh")
+
+STAGES = Path(__file__).resolve().parents[2] / "shared" / "cases" / "limb-bud" / "3d"
+PAIRS = [(250, 270), (270, 250), (270, 290), (290, 270), (250, 290), (290, 250)]
+
+
+def require_cases():
+    if STAGES.is_dir():
+        return
+    if os.environ.get("CI", "").lower() == "true":
+        pytest.fail(f"the real cases are missing ({STAGES}); CI must run these tests")
+    pytest.skip("the shared real cases are not beside the project")
+
+
+@pytest.fixture(scope="module")
+def stages():
+    require_cases()
+    return {h: trimesh.load(STAGES / f"limb_{h}h_closed.ply", process=False) for h in (250, 270, 290)}
+
+
+@pytest.fixture(scope="module")
+def remeshed(stages):
+    # Even triangles at each stage's median edge length, as a user would remesh them.
+    return {h: mm.remesh_surface(s, float(np.median(s.edges_unique_length))) for h, s in stages.items()}
+
+
+def check_default(s1, s2):
+    """The default's contract: S1's field, complete and fold-free, or GeometryError with counts.
+    Returns the field or None."""
+    try:
+        field = mm.map_surfaces(s1, s2)
+    except mm.GeometryError as error:
+        assert "no complete, fold-free field from the" in str(error)
+        assert "triangles folded around (" in str(error)
+        return None
+    np.testing.assert_array_equal(field.starts, s1.vertices)
+    np.testing.assert_array_equal(field.faces, s1.faces)
+    assert field.valid.all()
+    assert mm.quality(field, s1, s2).folds == 0
+    on_s2 = mm.SurfaceIndex(s2.vertices, s2.faces).closest_points(field.ends).distances
+    assert on_s2.max() < 1e-6 * np.ptp(s2.vertices, axis=0).max()
+    return field
+
+
+def test_remesh_surface_evens_the_caps(stages):
+    for s in stages.values():
+        edge = float(np.median(s.edges_unique_length))
+        even = mm.remesh_surface(s, edge)
+        assert even.is_watertight and even.is_winding_consistent and even.volume > 0
+        assert abs(even.volume / s.volume - 1) < 0.05  # new chords of the 226-vertex bud: -2.5%
+        assert np.degrees(even.face_angles.min()) > 10 > np.degrees(s.face_angles.min())
+
+
+@pytest.mark.parametrize("pair", PAIRS, ids=[f"{a}-{b}" for a, b in PAIRS])
+def test_the_default_never_folds_silently_on_the_stages_as_given(stages, pair):
+    check_default(stages[pair[0]], stages[pair[1]])
+
+
+# The remeshed pairs the default maps; on 250 -> 270 and 290 -> 250 every way leaves 1 to 2
+# folded triangles (bench/README.md "Real 3D stages") and it raises.
+MAPPED_REMESHED = [(270, 250), (270, 290), (290, 270), (250, 290)]
+
+
+@pytest.mark.parametrize("pair", PAIRS, ids=[f"{a}-{b}" for a, b in PAIRS])
+def test_the_default_on_the_remeshed_stages(remeshed, pair):
+    field = check_default(remeshed[pair[0]], remeshed[pair[1]])
+    if pair in MAPPED_REMESHED:
+        assert field is not None
+
+
+@pytest.mark.parametrize("pair", [(270, 290), (290, 270)], ids=["270-290", "290-270"])
+def test_every_method_returns_the_field_of_s1_on_the_crossing_pair(stages, pair):
+    s1, s2 = stages[pair[0]], stages[pair[1]]
+    for method in ("normal", "minimal_distance", "diffusion", "best"):
+        for reverse in ((False, True) if method != "best" else (False,)):
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # best warns that its winner folds (as every candidate does)
+                field = mm.map_surfaces(s1, s2, method, reverse=reverse)
+            assert len(field) == len(s1.vertices), (method, reverse)
+            np.testing.assert_array_equal(field.starts, s1.vertices)
+            np.testing.assert_array_equal(field.faces, s1.faces)
+
+
+def test_diffusion_loses_no_streamline_on_the_stages(stages):
+    for a, b in [(270, 290), (290, 270), (290, 250)]:
+        field = mm.map_surfaces(stages[a], stages[b], "diffusion")
+        assert field.valid.all(), (a, b)
