@@ -142,7 +142,6 @@ struct Defects {
   Index unmapped = 0, folded = 0;
   Eigen::RowVector3d where = Eigen::RowVector3d::Zero();  // the mean of the start points concerned
   bool none() const { return unmapped == 0 && folded == 0; }
-  Index total() const { return unmapped + folded; }
 };
 
 Defects defects(const DisplacementField3& field, const detail::FoldTest& test) {
