@@ -759,3 +759,29 @@ def test_a_crossing_ellipsoid_is_mapped_complete_and_fold_free(method):
     radial = np.einsum("ij,ij->i", field.vectors, v1)
     poles, waist = np.abs(v1[:, 0]) > 0.95, np.abs(v1[:, 0]) < 0.05
     assert (radial[poles] > 0).all() and (radial[waist] < 0).all()
+
+
+def flat_cone(radius, n=24, height=0.4):
+    """Apex on +z; the base a fan from rim vertex 1, so every corner of a base triangle lies on
+    the rim's sharp crease; the side faces first, so that each rim vertex's lowest face (the one a
+    closest-point query returns there) is a side face, whose normal leans against the base's."""
+    angle = 2 * np.pi * np.arange(n) / n
+    rim = np.c_[radius * np.cos(angle), radius * np.sin(angle), np.zeros(n)]
+    side = [[0, 1 + k, 1 + (k + 1) % n] for k in range(n)]
+    base = [[1, 2 + k, 1 + k] for k in range(1, n - 1)]
+    return np.vstack([[0.0, 0.0, height], rim]), np.array(side + base), np.array(base)
+
+
+def test_a_triangle_lying_on_its_surface_takes_that_surface_s_orientation_at_a_crease():
+    # The base of a flat cone shrunk into the inside of a wider cone's flat base: an
+    # orientation-preserving map (closed form: a scaling by 1/2 in the plane), so no fold. Asked
+    # at their corners alone, the rim's side faces would outvote the base and call all 22 folded.
+    v1, f1, base = flat_cone(1.0)
+    v2, f2, _ = flat_cone(2.0)
+    ends = v1 * [0.5, 0.5, 1.0]
+    ends[0] = v2[0]
+    field = mm.DisplacementField(v1, ends, "minimal_distance", base)
+    assert mm.quality(field, (v1, f1), (v2, f2)).folds == 0
+    # Mirrored in the plane (x -> -x), the same triangles are turned over: every one is a fold.
+    mirrored = mm.DisplacementField(v1, ends * [-1.0, 1.0, 1.0], "minimal_distance", base)
+    assert mm.quality(mirrored, (v1, f1), (v2, f2)).folds == len(base)

@@ -106,9 +106,12 @@ def quality(field, c1, c2, *, closed=True):
       (where the map from S1 to S2 reverses orientation):
       :math:`(n_j \cdot \nu^1_j)(N_j \cdot \nu^2_j) < 0`, with
       :math:`n_j = (p_1 - p_0) \times (p_2 - p_0)`, :math:`N_j` the same of the images (corners
-      in the order of the face row), :math:`\nu^1_j` the sum of the outward unit normals of the
-      faces of S1 closest to :math:`p_0, p_1, p_2` and to their centroid, and :math:`\nu^2_j` the
-      same on S2 for the images. A triangle lying on its surface as that surface is oriented has
+      in the order of the face row), :math:`\nu^1_j` the outward unit normal of the face of S1
+      closest to the centroid where the centroid lies on S1 (within :math:`10^{-9}` of the
+      triangle's longest edge: the triangle lies on S1, as a face of it or inside a flat part),
+      else the sum of the outward unit normals of the faces of S1 closest to
+      :math:`p_0, p_1, p_2` and to their centroid (at a sharp crease the corners' faces may all
+      lie on its other side); :math:`\nu^2_j` the same on S2 for the images. A triangle lying on its surface as that surface is oriented has
       :math:`n \cdot \nu > 0`, so tilt in space does not count (a bud that grows out sideways,
       a rotation, a scaling), a locally mirrored image does; triangles with a zero-area start
       or image are not folds.

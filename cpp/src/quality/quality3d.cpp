@@ -24,6 +24,10 @@ using detail::kNaN;
 
 namespace {
 
+// A centroid this close to the surface, relative to its triangle's longest edge, lies on it:
+// the rounding of the closest-point query, far below any chord's sagitta.
+constexpr double kOnSurface = 1e-9;
+
 using detail::V3;
 
 bool usable(const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, Index j) {
@@ -80,7 +84,8 @@ V3 unit_face_normal(const Points3Ref& v, const FacesRef& f, Index face, const ch
 // is large against the surface's curvature (across a thin tube its centroid sinks towards the
 // axis); but a corner on a vertex or edge of the surface gets any of the faces meeting there, while
 // the centroid of a small triangle lies over the face it covers. Together they outvote either
-// failure.
+// failure, except where every corner lies on a sharp crease: a triangle lying on the surface
+// takes the normal of the face under its centroid alone.
 Points3 normals_under(const Points3Ref& points, const FacesRef& faces, const std::vector<Index>& triangles,
                       const Points3Ref& v, const FacesRef& f, const SurfaceIndex& index, const char* name) {
   const Index count = static_cast<Index>(triangles.size());
@@ -103,12 +108,21 @@ Points3 normals_under(const Points3Ref& points, const FacesRef& faces, const std
     const Index j = triangles[static_cast<std::size_t>(k)];
     centroids.row(k) = (points.row(faces(j, 0)) + points.row(faces(j, 1)) + points.row(faces(j, 2))) / 3.0;
   }
-  const IndexVector hit = index.closest_points(centroids).faces;
+  const SurfaceHits hit = index.closest_points(centroids);
   for (Index k = 0; k < count; ++k) {
     const Index j = triangles[static_cast<std::size_t>(k)];
-    nu.row(k) = (unit_face_normal(v, f, hit[k], name) + at_corner(faces(j, 0)) + at_corner(faces(j, 1)) +
-                 at_corner(faces(j, 2)))
-                    .transpose();
+    const V3 under = unit_face_normal(v, f, hit.faces[k], name);
+    // A triangle whose centroid lies on the surface lies on it (it is one of its faces, or inside
+    // a flat part): that face's normal is its orientation, and the corners' faces, which at a
+    // sharp crease may all lie on the crease's other side, are not asked.
+    const double size = std::max({(points.row(faces(j, 1)) - points.row(faces(j, 0))).norm(),
+                                  (points.row(faces(j, 2)) - points.row(faces(j, 1))).norm(),
+                                  (points.row(faces(j, 0)) - points.row(faces(j, 2))).norm()});
+    if (hit.distances[k] <= kOnSurface * size) {
+      nu.row(k) = under.transpose();
+      continue;
+    }
+    nu.row(k) = (under + at_corner(faces(j, 0)) + at_corner(faces(j, 1)) + at_corner(faces(j, 2))).transpose();
   }
   return nu;
 }
