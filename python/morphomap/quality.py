@@ -111,9 +111,10 @@ def quality(field, c1, c2, *, closed=True):
       triangle's longest edge: the triangle lies on S1, as a face of it or inside a flat part),
       else the sum of the outward unit normals of the faces of S1 closest to
       :math:`p_0, p_1, p_2` and to their centroid (at a sharp crease the corners' faces may all
-      lie on its other side); :math:`\nu^2_j` the same on S2 for the images. A triangle lying on its surface as that surface is oriented has
-      :math:`n \cdot \nu > 0`, so tilt in space does not count (a bud that grows out sideways,
-      a rotation, a scaling), a locally mirrored image does; triangles with a zero-area start
+      lie on its other side); :math:`\nu^2_j` the same on S2 for the images. A triangle lying
+      on its surface as that surface is oriented has :math:`n \cdot \nu > 0`, so tilt in
+      space does not count (a bud that grows out sideways, a rotation, a scaling), a locally
+      mirrored image does; triangles with a zero-area start
       or image are not folds.
 
     Both surfaces must be closed; valid start points must lie on S1 and valid end points on S2
