@@ -6,7 +6,8 @@ One table over the three stages' pairs in both directions (250/270/290 h; 270 an
 the flank), as given (coarse, closed by flat caps of long thin triangles) and remeshed at each
 stage's median edge length (``remesh_surface``): for the default (``auto``) and ``diffusion``,
 the vectors (one per vertex of S1), valid ones, folded triangles, QM and seconds (one run each),
-or the error's first words where the call raised.
+or the error's first words where the call raised. Then the stages voxelised at 12 units on one
+grid and contoured by ``surface_from_mask`` (18k / 68k / 123k faces): the default on four pairs.
 """
 
 from __future__ import annotations
@@ -24,6 +25,37 @@ PAIRS = ((250, 270), (270, 250), (270, 290), (290, 270), (250, 290), (290, 250))
 METHODS = ("auto", "diffusion")
 
 
+def voxelised(stages, pitch=12.0):
+    """Each stage filled on one grid of ``pitch`` and contoured back: a mask as a lab would have it."""
+    low = np.min([s.bounds[0] for s in stages.values()], axis=0) - 2 * pitch
+    out = {}
+    for hour, surface in stages.items():
+        index = np.round((surface.voxelized(pitch=pitch).fill().points - low) / pitch).astype(int)
+        mask = np.zeros(tuple(index.max(0)[::-1] + 3), bool)  # (z, y, x)
+        mask[index[:, 2], index[:, 1], index[:, 0]] = True
+        contoured = mm.surface_from_mask(mask, (pitch, pitch, pitch))
+        contoured.apply_translation(low)
+        out[hour] = contoured
+    return out
+
+
+def row(label, a, b, method, s1, s2):
+    begin = time.perf_counter()
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            field = mm.map_surfaces(s1, s2, method)
+    except (ValueError, RuntimeError) as error:
+        seconds = time.perf_counter() - begin
+        print(f"{label:8s} {a}->{b:<4d} {method:10s} {'':>8s} {'':>6s} {'':>6s} {'':>9s} {seconds:8.1f}  "
+              f"raised: {str(error)[:60]}")
+        return
+    seconds = time.perf_counter() - begin
+    q = mm.quality(field, s1, s2)
+    print(f"{label:8s} {a}->{b:<4d} {method:10s} {len(field):8d} {int(field.valid.sum()):6d} {q.folds:6d} "
+          f"{q.qm:9.3g} {seconds:8.1f}", flush=True)
+
+
 def main():
     import trimesh
 
@@ -35,21 +67,10 @@ def main():
         for a, b in PAIRS:
             s1, s2 = stages[a], stages[b]
             for method in METHODS:
-                begin = time.perf_counter()
-                try:
-                    with warnings.catch_warnings():
-                        warnings.simplefilter("ignore")
-                        field = mm.map_surfaces(s1, s2, method)
-                except (ValueError, RuntimeError) as error:
-                    seconds = time.perf_counter() - begin
-                    print(f"{label:8s} {a}->{b:<4d} {method:10s} {'':>8s} {'':>6s} {'':>6s} {'':>9s} {seconds:8.1f}  "
-                          f"raised: {str(error)[:60]}")
-                    continue
-                seconds = time.perf_counter() - begin
-                q = mm.quality(field, s1, s2)
-                print(f"{label:8s} {a}->{b:<4d} {method:10s} {len(field):8d} {int(field.valid.sum()):6d} {q.folds:6d} "
-                      f"{q.qm:9.3g} {seconds:8.1f}", flush=True)
-
+                row(label, a, b, method, s1, s2)
+    masks = voxelised(given)
+    for a, b in ((270, 290), (290, 270), (250, 270), (270, 250)):
+        row("voxels", a, b, "auto", masks[a], masks[b])
 
 if __name__ == "__main__":
     main()

@@ -145,7 +145,7 @@ def _random_blob_2d(rng) -> Blob2D:
 
 
 def _grow_2d(blob: Blob2D, rng) -> tuple[Blob2D, str]:
-    kinds = ["scale", "bud", "partial", "partial", "mixed"] + (["knob"] if blob.knobs else [])
+    kinds = ["scale", "bud", "partial", "partial", "mixed", "drift"] + (["knob"] if blob.knobs else [])
     kind = str(rng.choice(kinds))
     if kind == "scale":
         s = rng.uniform(0.04, 0.35)
@@ -413,7 +413,7 @@ def _random_blob_3d(rng) -> Blob3D:
 
 
 def _grow_3d(blob: Blob3D, rng) -> tuple[Blob3D, str]:
-    kinds = ["scale", "bud", "partial", "partial", "mixed"] + (["knob"] if blob.knobs else [])
+    kinds = ["scale", "bud", "partial", "partial", "mixed", "drift"] + (["knob"] if blob.knobs else [])
     kind = str(rng.choice(kinds))
     if kind == "scale":
         s = rng.uniform(0.08, 0.35)
@@ -437,6 +437,11 @@ def _grow_3d(blob: Blob3D, rng) -> tuple[Blob3D, str]:
         # Where u . axis > t (a cap of (1 - t) / 2 of the directions) the surface moves out.
         amount = rng.uniform(0.12, 0.45) * (-0.5 if rng.random() < 0.15 else 1.0)
         grown = blob.copy(window=(_unit(rng), rng.uniform(-0.6, 0.4), amount))
+    elif kind == "drift":
+        # Grown a little and moved by a fifth of its size or more: the surfaces cross, as frames
+        # of a drifting sample do before registration.
+        s = rng.uniform(0.0, 0.15)
+        grown = blob.copy(scale_xyz=(1 + s, 1 + s, 1 + s), shift=tuple(_unit(rng) * rng.uniform(0.2, 0.35)))
     else:
         s = rng.uniform(0.04, 0.15)
         grown = blob.copy(scale_xyz=(1 + s, 1 + s, 1 + s * rng.uniform(0.5, 1.5)),

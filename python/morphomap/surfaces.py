@@ -181,7 +181,9 @@ def map_surfaces(s1, s2, method="auto", *, reverse=False, mesh_size=None, repeat
         turn, the first such field returned: normal mapping; between nested surfaces the normal
         field with diffusion within two mean gaps of where it failed (its ends blended into the
         normal ones and put on ``s2``); reverse diffusion carried onto ``s1``'s vertices (the
-        paper's choice); diffusion; minimal distance. A diffusion field with a few folded
+        paper's choice); diffusion; minimal distance; normal mapping and minimal distance from
+        ``s2``'s vertices, carried onto ``s1``'s. With ``reverse=True`` the same ways run from
+        ``s2``, each carried onto ``s1`` and judged there. A diffusion field with a few folded
         triangles left has the ends around them (up to 4 edges away) re-placed by the harmonic
         interpolation of the ends around, put on ``s2``, if that leaves no fold.
         ``field.method`` says which way each vector came.

@@ -25,7 +25,9 @@ struct SurfaceMappingOptions {
   //   triangles folded, and where. Tried in turn: normal mapping; between nested surfaces, the
   //   normal field with diffusion within two mean gaps of where it failed; reverse diffusion
   //   carried onto S1's vertices; diffusion (each diffusion with the ends around its last folds
-  //   re-placed by harmonic interpolation where that removes them); minimal distance.
+  //   re-placed by harmonic interpolation where that removes them); minimal distance; reverse
+  //   normal mapping and reverse minimal distance, carried. Reversed, the same ways from S2,
+  //   each carried onto S1 and judged there.
   // Only the methods kMethodTable marks `surfaces`: uniform, optimal and paper have no 3D form
   // (InvalidInput).
   MapMethod method = MapMethod::automatic;

@@ -235,19 +235,30 @@ std::optional<DisplacementField3> smoothed_over_folds(const DisplacementField3& 
 // Tried in turn, the first such field returned: normal mapping; between nested surfaces, the
 // normal field with diffusion near where it failed (local_diffusion.hpp); reverse diffusion
 // carried onto S1's vertices (the paper's choice where normal mapping fails); diffusion; minimal
-// distance. Diffusion's lost streamlines are filled and its turned slivers repaired within each.
-DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diffusion) {
+// distance; reverse normal mapping and reverse minimal distance, carried. Diffusion's lost
+// streamlines are filled and its turned slivers repaired within each. `outer`: where this runs
+// the other way round (reverse), the call's own work pair: each candidate is carried onto its S1
+// and judged there.
+DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diffusion, const Work* outer = nullptr) {
   const Pair& pair = work.user;
   const Surface& source = pair.source;
   const Surface& target = pair.target;
   const SurfaceIndex& source_index = *work.user_source;
   const SurfaceIndex& target_index = *work.user_target;
+  // What the call answers with, and the test it must pass: on the call's own S1.
+  const Work& call = outer != nullptr ? *outer : work;
+  const Surface& s1 = call.user.source;
+  const Surface& s2 = call.user.target;
+  const detail::FoldTest test(s1.vertices, s1.faces, s1.vertices, s1.faces, *call.user_source, s2.vertices, s2.faces,
+                              *call.user_target);
+  const auto answer = [&](DisplacementField3 field) {
+    return outer == nullptr ? field : carried(field, outer->user, *outer->user_source, *outer->user_target);
+  };
   if (diffusion.on_stage) diffusion.on_stage("normal");
   DisplacementField3 normal = basic(MapMethod::normal, pair, target_index, diffusion);
-  const detail::FoldTest test(source.vertices, source.faces, source.vertices, source.faces, source_index,
-                              target.vertices, target.faces, target_index);
-  const Defects normal_defects = defects(normal, test);
-  if (normal_defects.none()) return normal;
+  DisplacementField3 normal_answer = answer(normal);
+  const Defects normal_defects = defects(normal_answer, test);
+  if (normal_defects.none()) return normal_answer;
   std::vector<std::pair<std::string, Defects>> tried{{"normal", normal_defects}};
   // Diffusion needs a region between the surfaces; where one of them encloses no volume the
   // attempts would be refused (require_volume), so they are not made.
@@ -255,10 +266,17 @@ DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diff
                           detail::encloses_volume(target.volume, target.vertices);
   if (diffusable && pair.nesting != detail::Nesting::crossing) {
     try {
-      const std::vector<char> folded = test.folded(normal.ends);
+      const std::vector<char> folded =
+          outer == nullptr ? test.folded(normal.ends)
+                           : detail::FoldTest(source.vertices, source.faces, source.vertices, source.faces,
+                                              source_index, target.vertices, target.faces, target_index)
+                                 .folded(normal.ends);
       std::optional<DisplacementField3> field =
           detail::normal_with_local_diffusion(normal, folded, shell_pair(pair, target_index), source_index, diffusion);
-      if (field && defects(*field, test).none()) return std::move(*field);
+      if (field) {
+        DisplacementField3 local = answer(std::move(*field));
+        if (defects(local, test).none()) return local;
+      }
     } catch (const GeometryError&) {
     } catch (const InvalidInput&) {  // surfaces whose region diffusion cannot mesh (they coincide in part, say)
     }
@@ -267,11 +285,11 @@ DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diff
     if (!diffusable) break;
     const char* name = backwards ? "reverse diffusion" : "diffusion";
     try {
-      DisplacementField3 field = diffusion_field(work, backwards, diffusion);
+      DisplacementField3 field = answer(diffusion_field(work, backwards, diffusion));
       const Defects found = defects(field, test);
       if (found.none()) return field;
       if (found.unmapped == 0) {
-        if (std::optional<DisplacementField3> smoothed = smoothed_over_folds(field, test, target_index))
+        if (std::optional<DisplacementField3> smoothed = smoothed_over_folds(field, test, *call.user_target))
           return *smoothed;
       }
       tried.emplace_back(name, found);
@@ -281,12 +299,21 @@ DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diff
       tried.emplace_back(std::string(name) + " (" + error.what() + ")", Defects{-1, -1});
     }
   }
-  DisplacementField3 nearest = basic(MapMethod::minimal_distance, pair, target_index, diffusion);
+  // The cheap ways last: minimal distance, and normal mapping and minimal distance from S2's
+  // vertices carried onto S1's (where S2 is the finer or the smoother surface, say).
+  DisplacementField3 nearest = answer(basic(MapMethod::minimal_distance, pair, target_index, diffusion));
   const Defects nearest_defects = defects(nearest, test);
   if (nearest_defects.none()) return nearest;
   tried.emplace_back("minimal distance", nearest_defects);
-  std::string message = "map_surfaces: no complete, fold-free field from the " +
-                        std::to_string(source.vertices.rows()) + " vertices of s1 to s2 (";
+  for (const MapMethod method : {MapMethod::normal, MapMethod::minimal_distance}) {
+    DisplacementField3 back =
+        answer(carried(basic(method, pair.swapped(), source_index, diffusion), pair, source_index, target_index));
+    const Defects found = defects(back, test);
+    if (found.none()) return back;
+    tried.emplace_back(method == MapMethod::normal ? "reverse normal" : "reverse minimal distance", found);
+  }
+  std::string message = "map_surfaces: no complete, fold-free field from the " + std::to_string(s1.vertices.rows()) +
+                        " vertices of s1 to s2 (";
   for (std::size_t k = 0; k < tried.size(); ++k) {
     const auto& [name, found] = tried[k];
     message += (k > 0 ? "; " : "") + name;
@@ -402,6 +429,7 @@ DisplacementField3 checked(Surface s1, Surface s2, const SurfaceMappingOptions& 
   const Work work =
       diffuses ? work_pair(user, refined1, refined2) : Work{user, user, s1.index, s2.index, s1.index, s2.index, false};
   if (!options.reverse) return directed(options.method, work, diffusion);
+  if (options.method == MapMethod::automatic) return automatic(work.swapped(), diffusion, &work);
   return carried(directed(options.method, work.swapped(), diffusion), user, *s1.index, *s2.index);
 }
 
