@@ -19,7 +19,8 @@ therefore shared exactly by both curves.
 
 3D (:func:`surface_pair`): the same with voxel volumes (24-34 voxels along the finest axis, anisotropic spacing
 (sz, sy, sx)): a lumpy ball (zonal-harmonic-like radius perturbations about random axes, buds,
-knobs) and a grown version on the same grid, optionally debris and a cavity and smoothing;
+knobs) and a grown version on the same grid (or one moved by a fifth of its size or more, so that
+the two cross), optionally debris and a cavity and smoothing;
 ``skimage.measure.marching_cubes`` on the zero-padded volume with the spacing, vertices reordered
 to (x, y, z), faces oriented outward (by the signed volume), duplicate vertices merged
 (``trimesh.Trimesh(process=True)``).
@@ -145,7 +146,7 @@ def _random_blob_2d(rng) -> Blob2D:
 
 
 def _grow_2d(blob: Blob2D, rng) -> tuple[Blob2D, str]:
-    kinds = ["scale", "bud", "partial", "partial", "mixed", "drift"] + (["knob"] if blob.knobs else [])
+    kinds = ["scale", "bud", "partial", "partial", "mixed"] + (["knob"] if blob.knobs else [])
     kind = str(rng.choice(kinds))
     if kind == "scale":
         s = rng.uniform(0.04, 0.35)
