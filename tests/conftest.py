@@ -3,6 +3,7 @@
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -35,11 +36,23 @@ def wobbly():
     return np.column_stack([r * np.cos(t), r * np.sin(t)])
 
 
+#: The real cases beside the project (../shared/cases): read by the tests, never copied in.
+SHARED_CASES = Path(__file__).resolve().parents[1].parent / "shared" / "cases"
+
+
+def require_cases(path: Path) -> None:
+    """Skip a test of the real cases where ``path`` (under SHARED_CASES) is absent; in CI (CI=true)
+    fail instead: CI must run them."""
+    if path.exists():
+        return
+    if os.environ.get("CI", "").lower() == "true":
+        pytest.fail(f"the real cases are missing ({path.relative_to(SHARED_CASES.parent)}); CI must run this test")
+    pytest.skip("the shared real cases are not beside the project")
+
+
 def require_client(available: bool, what: str) -> None:
     """Skip a test of a real client (FEniCSx, ParaView) that this machine lacks; in CI (CI=true),
     where .ci/run installs them, fail instead."""
-    import os
-
     if available:
         return
     if os.environ.get("CI", "").lower() == "true":

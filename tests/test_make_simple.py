@@ -1,20 +1,19 @@
 """make_simple: contours as labs trace them (pixel necks and spurs, repeats, a seam glitch) made
 simple, genuine self-intersections refused, simple curves passed through bit for bit."""
 
-import os
 import time
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
 from skimage import measure
 
 import morphomap as mm
+from conftest import SHARED_CASES, require_cases
 from conftest import circle, morphomap
 from morphomap.simple import NECK_OPENING
 
-LIMB = Path(__file__).resolve().parents[1].parent / "shared" / "cases" / "limb-bud" / "2d"
+LIMB = SHARED_CASES / "limb-bud" / "2d"
 GLITCHES = (278, 279, 280, 338, 339, 340, 341, 342)
 
 # Moore neighbourhood, clockwise on the screen (row down): N, NE, E, SE, S, SW, W, NW.
@@ -276,11 +275,7 @@ def test_bad_arguments():
 
 
 def require_limb():
-    if LIMB.is_dir():
-        return
-    if os.environ.get("CI", "").lower() == "true":
-        pytest.fail("the real cases (limb-bud/2d) are missing; CI must run these tests")
-    pytest.skip("the shared real cases are not beside the project")
+    require_cases(LIMB)
 
 
 def outline(hour):

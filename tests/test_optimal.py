@@ -1,17 +1,16 @@
 """method="optimal": order-preserving, onto all of C2, no crossings; radial on concentric circles;
 below the paper's Table 1 on its pair. The DP itself against a closed form: tests/cpp/test_optimal.cpp."""
 
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import morphomap as mm
-from conftest import circle, ellipse
+from conftest import SHARED_CASES, circle, ellipse, require_cases
 
 import frames  # noqa: E402  (next to this file)
 
-CASES = Path(__file__).resolve().parents[1].parent / "shared" / "cases"
+CASES = SHARED_CASES
 #: QM1 of every row of the paper's Table 1 (circle onto ellipse; bench/paper_table1.py has the table).
 TABLE1_QM1 = (13.4, 0.128, 1.69, 0.103, 56.1, 0.084, 0.494, 1.589, 0.224)
 
@@ -52,8 +51,7 @@ def test_bundled_pairs(name):
 
 
 def test_shared_frames():
-    if not (CASES / "frame2.csv").exists():
-        pytest.skip("the shared cases are not beside the project")
+    require_cases(CASES / "frame2.csv")
     c1, c2 = mm.read_curve(CASES / "frame2.csv"), mm.read_curve(CASES / "frame3.csv")
     field = mm.map_curves(c1, c2, "optimal")
     check_order_preserving(field, c1, c2)

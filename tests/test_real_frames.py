@@ -5,7 +5,6 @@ import signal
 import subprocess
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,14 +12,13 @@ import trimesh
 from skimage import measure
 
 import morphomap as mm
-from conftest import circle, ellipse
+from conftest import SHARED_CASES, circle, ellipse, require_cases
 
-CASES = Path(__file__).resolve().parents[1].parent / "shared" / "cases"
+CASES = SHARED_CASES
 
 
 def shared_frames():
-    if not (CASES / "frame2.csv").exists():
-        pytest.skip("the shared cases are not beside the project")
+    require_cases(CASES / "frame2.csv")
     return mm.read_curve(CASES / "frame2.csv"), mm.read_curve(CASES / "frame3.csv")
 
 

@@ -4,25 +4,20 @@ vector valid, and no crossings, closed and open, on every consecutive, 4 h and 8
 long jumps (330 -> 381 h among them, where the paper's Algorithm 1 crosses).
 """
 
-import os
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import morphomap as mm
+from conftest import SHARED_CASES, require_cases
 
-LIMB = Path(__file__).resolve().parents[1].parent / "shared" / "cases" / "limb-bud" / "2d"
+LIMB = SHARED_CASES / "limb-bud" / "2d"
 HOURS = range(248, 382)
 
 
-def require_cases():
-    if LIMB.is_dir():
-        return
-    if os.environ.get("CI", "").lower() == "true":
-        pytest.fail(f"the real cases are missing ({LIMB.name}); CI must run these tests")
-    pytest.skip("the shared real cases are not beside the project")
+def require_limb():
+    require_cases(LIMB)
 
 
 def outline(hour):
@@ -56,7 +51,7 @@ def check_default(c1, c2, closed):
 
 @pytest.mark.parametrize("closed", [True, False], ids=["closed", "open"])
 def test_default_is_crossing_free_and_complete_on_every_pair(closed):
-    require_cases()
+    require_limb()
     failures = []
     curves = {h: outline(h) for h in HOURS}
     for a, b in pairs():
@@ -71,7 +66,7 @@ def test_default_is_crossing_free_and_complete_on_every_pair(closed):
 def test_the_lobed_jump_the_paper_crosses_on(closed):
     # 330 h -> 381 h: digit lobes appear. The paper's Algorithm 1 gives reverse diffusion vectors
     # that cross where the streamlines fan into a lobe; the default does not.
-    require_cases()
+    require_limb()
     c1, c2 = outline(330), outline(381)
     paper = mm.map_curves(c1, c2, "paper", closed=closed)
     assert mm.quality(paper, c1, c2, closed=closed).crossings > 0

@@ -3,32 +3,23 @@ README): coarse, closed by flat caps of long thin triangles, and 270/290 cross n
 The default ("auto") returns every vertex of S1 mapped with no folded triangle, or raises
 GeometryError saying how each way failed; every method returns one vector per vertex of S1."""
 
-import os
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import morphomap as mm
+from conftest import SHARED_CASES, require_cases
 
 trimesh = pytest.importorskip("trimesh")
 
-STAGES = Path(__file__).resolve().parents[2] / "shared" / "cases" / "limb-bud" / "3d"
+STAGES = SHARED_CASES / "limb-bud" / "3d"
 PAIRS = [(250, 270), (270, 250), (270, 290), (290, 270), (250, 290), (290, 250)]
-
-
-def require_cases():
-    if STAGES.is_dir():
-        return
-    if os.environ.get("CI", "").lower() == "true":
-        pytest.fail(f"the real cases are missing ({STAGES}); CI must run these tests")
-    pytest.skip("the shared real cases are not beside the project")
 
 
 @pytest.fixture(scope="module")
 def stages():
-    require_cases()
+    require_cases(STAGES)
     return {h: trimesh.load(STAGES / f"limb_{h}h_closed.ply", process=False) for h in (250, 270, 290)}
 
 

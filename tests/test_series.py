@@ -1,15 +1,13 @@
 """Time series: chained fields and trajectories against closed forms."""
 
-import os
 import re
-from pathlib import Path
 
 import numpy as np
 import pytest
 import trimesh
 
 import morphomap as mm
-from conftest import circle
+from conftest import SHARED_CASES, circle, require_cases
 
 
 def test_circles_keep_their_angle_and_reach_each_radius():
@@ -323,16 +321,10 @@ def test_prepared_curves_refuse_what_they_are_not():
         mm.quality(field, prepared, mm.PreparedSurface(sphere))
 
 
-CASES = Path(__file__).resolve().parents[1].parent / "shared" / "cases"
-
-
 def limb_outlines(first, last):
     """The hourly limb-bud outlines (open), read from the shared cases beside the project."""
-    folder = CASES / "limb-bud" / "2d"
-    if not (folder / f"limb_h{first}.csv").exists():
-        if os.environ.get("CI", "").lower() == "true":
-            pytest.fail("the shared limb-bud cases are missing, and CI must run this test")
-        pytest.skip("the shared cases are not beside the project")
+    folder = SHARED_CASES / "limb-bud" / "2d"
+    require_cases(folder / f"limb_h{first}.csv")
     return [mm.read_curve(folder / f"limb_h{hour}.csv") for hour in range(first, last + 1)]
 
 

@@ -258,9 +258,10 @@ def test_reverse_is_carried_onto_the_vertices_of_s1(sphere):
     on_s2 = mm.SurfaceIndex(v2, f2).closest_points(field.ends).distances
     assert on_s2.max() < 1e-9
     # Concentric spheres of radius 1 and 2 (one mesh scaled): reverse normal mapping takes 2p to
-    # about p, so carried back each vertex p goes to about 2p (the normals are nearly radial).
+    # about p, so carried back each vertex p goes to about 2p (the normals are nearly radial; at
+    # 5,120 faces the largest miss is 0.0044, the faceting).
     big = mm.map_surfaces((v1, f1), (2 * v1, f1), "normal", reverse=True)
-    assert np.abs(big.ends - 2 * v1).max() < 0.02
+    assert np.abs(big.ends - 2 * v1).max() < 0.008
 
 
 def test_quality_of_the_identity_and_a_scaling(sphere):

@@ -285,7 +285,10 @@ DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diff
     if (!diffusable) break;
     const char* name = backwards ? "reverse diffusion" : "diffusion";
     try {
-      DisplacementField3 field = answer(diffusion_field(work, backwards, diffusion));
+      // Reversed, the work's other way round is the call's own direction: mapped there at once,
+      // not carried twice.
+      DisplacementField3 field = outer != nullptr ? diffusion_field(*outer, !backwards, diffusion)
+                                                  : diffusion_field(work, backwards, diffusion);
       const Defects found = defects(field, test);
       if (found.none()) return field;
       if (found.unmapped == 0) {
@@ -306,8 +309,9 @@ DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diff
   if (nearest_defects.none()) return nearest;
   tried.emplace_back("minimal distance", nearest_defects);
   for (const MapMethod method : {MapMethod::normal, MapMethod::minimal_distance}) {
-    DisplacementField3 back =
-        answer(carried(basic(method, pair.swapped(), source_index, diffusion), pair, source_index, target_index));
+    DisplacementField3 back = outer != nullptr ? basic(method, outer->user, *outer->user_target, diffusion)
+                                               : carried(basic(method, pair.swapped(), source_index, diffusion), pair,
+                                                         source_index, target_index);
     const Defects found = defects(back, test);
     if (found.none()) return back;
     tried.emplace_back(method == MapMethod::normal ? "reverse normal" : "reverse minimal distance", found);
@@ -422,7 +426,12 @@ DisplacementField3 checked(Surface s1, Surface s2, const SurfaceMappingOptions& 
   diffusion.repeatable = options.diffusion_repeatable;
   diffusion.on_stage = options.on_stage;
   std::unique_ptr<SurfaceIndex> index_built1, index_built2;
-  detail::run_both([&] { s1.index = &index_of(s1, index_built1); }, [&] { s2.index = &index_of(s2, index_built2); });
+  // S1's own index serves auto's fold test, diffusion's repair and carrying a reversed field
+  // back; normal mapping and minimal distance query S2 alone.
+  const bool source_queried =
+      options.reverse || options.method == MapMethod::automatic || options.method == MapMethod::diffusion;
+  detail::run_both([&] { s1.index = source_queried ? &index_of(s1, index_built1) : s1.index; },
+                   [&] { s2.index = &index_of(s2, index_built2); });
   const Pair user{s1, s2, nesting};
   Refined refined1, refined2;
   const bool diffuses = options.method == MapMethod::diffusion || options.method == MapMethod::automatic;
