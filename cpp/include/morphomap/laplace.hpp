@@ -11,8 +11,10 @@ struct DiffusionOptions {
   // the lattice, a triangle next to a point the mesher added may reach the lattice triangles'
   // circumdiameter (1.12 times it). 0 picks mesh_fraction * the mean gap between the curves
   // (twice the region's area over its boundary length), but no finer than a lattice of
-  // max(40000, 20 * the number of curve points) vertices over the region would be. Near the curves the mesh is graded
-  // from their point spacing and refined where the gap is narrow, whatever this bound.
+  // max(40000, 20 * the number of curve points) vertices over the region would be; map_curves shares that
+  // budget among the pieces it splits a pair into, in proportion to their points (each at least 2000 and
+  // 20 per point). Near the curves the mesh is graded from their point spacing and refined where the gap
+  // is narrow, whatever this bound.
   double mesh_size = 0.0;
   double mesh_fraction = 0.02;
   bool keep_streamlines = false;

@@ -331,12 +331,11 @@ void require_in_range(const Points2Ref& points, Index rows, const char* name) {
 }
 
 DiffusionSolution solve(const Points2Ref& source_points, const Points2Ref& target_points, bool closed,
-                        const DiffusionOptions& options);
+                        const DiffusionOptions& options, double vertex_budget);
 
 }  // namespace
 
-DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2Ref& target_points, bool closed,
-                                  const DiffusionOptions& options) {
+void detail::require_diffusion_curves(const Points2Ref& source_points, const Points2Ref& target_points, bool closed) {
   const Index ns = detail::require_curve(source_points, closed, "c1");
   const Index nt = detail::require_curve(target_points, closed, "c2");
   require_in_range(source_points, ns, "c1");
@@ -348,22 +347,28 @@ DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2
     detail::require_area(source_points.topRows(ns), "c1");
     detail::require_area(target_points.topRows(nt), "c2");
   }
+}
+
+DiffusionSolution solve_diffusion(const Points2Ref& source_points, const Points2Ref& target_points, bool closed,
+                                  const DiffusionOptions& options) {
+  detail::require_diffusion_curves(source_points, target_points, closed);
   detail::require_diffusion_options(options);
-  return solve(source_points, target_points, closed, options);
+  return solve(source_points, target_points, closed, options, 0.0);
 }
 
 DiffusionSolution detail::solve_diffusion_unchecked(const Points2Ref& source_points, const Points2Ref& target_points,
-                                                    bool closed, const DiffusionOptions& options) {
+                                                    bool closed, const DiffusionOptions& options,
+                                                    double vertex_budget) {
   require_in_range(source_points, curve_size(source_points, closed), "c1");
   require_in_range(target_points, curve_size(target_points, closed), "c2");
-  return solve(source_points, target_points, closed, options);
+  return solve(source_points, target_points, closed, options, vertex_budget);
 }
 
 namespace {
 
 // solve_diffusion on checked curves and options.
 DiffusionSolution solve(const Points2Ref& source_points, const Points2Ref& target_points, bool closed,
-                        const DiffusionOptions& options) {
+                        const DiffusionOptions& options, double vertex_budget) {
   const Index ns = detail::curve_size(source_points, closed);
   const Index nt = detail::curve_size(target_points, closed);
   const Points2 source = source_points.topRows(ns), target = target_points.topRows(nt);
@@ -416,8 +421,9 @@ DiffusionSolution solve(const Points2Ref& source_points, const Points2Ref& targe
     const double boundary = detail::perimeter_unchecked(source, closed) + detail::perimeter_unchecked(target, closed);
     // A long thin region (a piece between two contact stretches, say) would get length / gap
     // times the vertices of a round one of the same gap: the lattice is kept within a budget of
-    // vertices (at 20 per curve point, 40000 at least), still 20 or more across such a gap.
-    const double budget = std::max(4e4, 20.0 * static_cast<double>(ns + nt));
+    // vertices (detail::vertex_budget: at 20 per curve point, 40000 at least), still 20 or more
+    // across such a gap. A piece of a split pair gets its share of the pair's budget.
+    const double budget = vertex_budget > 0.0 ? vertex_budget : detail::vertex_budget(ns + nt);
     const double coarsest = std::sqrt(2.0 / std::sqrt(3.0) * area / budget);
     max_edge = std::max(options.mesh_fraction * 2.0 * area / boundary, coarsest);
   }

@@ -161,10 +161,10 @@ Points2 basic_ends(MapMethod method, const Job& job, const Points2& starts, cons
       return ends;
     }
     case MapMethod::diffusion: {
-      const DiffusionSolution solution =
-          settings.simple_curves
-              ? detail::solve_diffusion_unchecked(job.source, job.target, job.source_closed, settings.diffusion)
-              : solve_diffusion(job.source, job.target, job.source_closed, settings.diffusion);
+      if (!settings.simple_curves) detail::require_diffusion_curves(job.source, job.target, job.source_closed);
+      const DiffusionSolution solution = detail::solve_diffusion_unchecked(
+          job.source, job.target, job.source_closed, settings.diffusion,
+          detail::piece_vertex_budget(job.source.rows() + job.target.rows(), settings.pair_points));
       Points2 ends(starts.rows(), 2);
       for (std::size_t j = 0; j < job.start_rows.size(); ++j) ends.row(j) = solution.ends.row(job.start_rows[j]);
       put_in_order(ends, target, target_index(job));

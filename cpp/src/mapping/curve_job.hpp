@@ -61,6 +61,7 @@ struct Settings {
   double density_threshold = 0.0;
   double contact_tolerance = -1.0;  // < 0: default_contact_tolerance
   DiffusionOptions diffusion;
+  Index pair_points = 0;  // points of both mapped curves: diffusion's pieces share their mesh budget
   double stretch_weight = kDefaultStretchWeight;  // "optimal"
   // The curves are the ones map_curves checked to be simple (not resampled or transformed), so
   // diffusion need not check them again.

@@ -439,6 +439,7 @@ DisplacementField2 detail::mapped_pair(const Points2Ref& c1, Index n1, const Cur
   settings.density_threshold = options.density_threshold;
   settings.contact_tolerance = options.contact_tolerance;
   settings.diffusion = options.diffusion;
+  settings.pair_points = a.rows() + b.rows();
   settings.stretch_weight = options.stretch_weight;
   settings.simple_curves = !derived;
   // The given curves' indices serve where the mapping runs on those curves (not resampled or moved).
