@@ -85,21 +85,46 @@ def test_deep_narrow_bud_without_crossings():
     check_order_preserving(mm.map_curves(c1, c2, "optimal"), c1, c2)
 
 
-def test_fingers_up_to_four_long_map_without_crossings():
+def test_fingers_up_to_six_long_map_without_crossings():
     # The finger's long edges make the target uneven, so it is sampled through its vertices too
     # (sample_arcs in optimal.cpp): the few start points facing it now reach its tip with vectors
     # inside the region. Equally spaced samples alone found no such path at 3 (12 crossing pairs).
-    for depth in (3.0, 4.0):
+    for depth in (3.0, 4.0, 5.0, 6.0):
         c1, c2 = budded(depth)
         check_order_preserving(mm.map_curves(c1, c2, "optimal"), c1, c2)
 
 
 def test_no_crossing_free_matching_is_refused():
-    # A finger 5 long: the few start points facing it cannot reach its tip with vectors inside the
+    # A finger 8 long: the few start points facing it cannot reach its tip with vectors inside the
     # region (each step advances a bounded stretch of C2).
-    c1, c2 = budded(5.0)
+    c1, c2 = budded(8.0)
     with pytest.raises(mm.GeometryError, match="no crossing-free order-preserving matching"):
         mm.map_curves(c1, c2, "optimal")
+
+
+def test_a_start_a_hair_from_a_long_edge_end_lands_beside_it():
+    # Open pieces whose target is one long edge: the start 0.001 from the end maps to the uniform
+    # map's point, not a whole sample step (1/16 of the edge) away from it.
+    c1 = np.array([[0.0, 0.0], [0.0, 0.999], [0.0, 1.0]])
+    c2 = np.array([[1.0, 0.0], [1.0, 1.0]])
+    field = mm.map_curves(c1, c2, "optimal", closed=False)
+    assert np.abs(field.ends[1] - [1.0, 0.999]).max() < 1e-12
+    assert mm.quality(field, c1, c2, closed=False).crossings == 0
+
+
+def test_an_end_doubling_back_shares_the_target_end():
+    # C1's last point lies back across the one before it (as a traced tip): the last vector
+    # separates C1's third point from all of C2 but C2's end, so the only crossing-free
+    # order-preserving field sends both there.
+    c1 = np.array([[0.0, 0.0], [0.5, 0.0], [1.0, 0.0], [0.98, 0.01]])
+    c2 = np.column_stack([np.linspace(0.0, 1.0, 9), np.full(9, -1.0)])
+    field = mm.map_curves(c1, c2, "optimal", closed=False)
+    assert field.valid.all()
+    assert mm.quality(field, c1, c2, closed=False).crossings == 0
+    np.testing.assert_array_equal(field.ends[2], c2[-1])
+    np.testing.assert_array_equal(field.ends[3], c2[-1])
+    # The rest keeps strict order along C2.
+    assert np.all(np.diff(field.ends[:3, 0]) > 0)
 
 
 @pytest.mark.parametrize("n, m, phase", [(100, 1000, 0.0), (100, 2570, 0.3), (400, 1500, 1.0)])

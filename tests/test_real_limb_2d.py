@@ -74,3 +74,46 @@ def test_the_lobed_jump_the_paper_crosses_on(closed):
     assert len(field.starts) >= len(c1)
     assert q.qm < 1.0
 
+
+
+@pytest.mark.parametrize("closed", [True, False], ids=["closed", "open"])
+def test_optimal_maps_every_pair_without_crossings(closed):
+    # Uneven outlines: the flank is one long edge beside points 0.01 apart, and where the curves
+    # cross on it a piece holds a start a hair from its end; a traced tip's last point lies back
+    # across the one before it (250 -> 270 h open). optimal maps every pair crossing-free.
+    require_limb()
+    failures = []
+    curves = {h: mm.make_simple(outline(h), closed=closed)[0] for h in HOURS}
+    for a, b in pairs():
+        c1, c2 = curves[a], curves[b]
+        try:
+            field = mm.map_curves(c1, c2, "optimal", closed=closed)
+            assert field.valid.all()
+            assert mm.quality(field, c1, c2, closed=closed).crossings == 0
+        except (AssertionError, ValueError, RuntimeError) as error:
+            failures.append(f"{a}->{b}: {str(error).splitlines()[0][:200]}")
+    assert not failures, f"{len(failures)} of {len(pairs())} pairs: " + "; ".join(failures[:10])
+
+
+def test_optimal_on_the_flank_is_as_even_as_normal_mapping():
+    # 300 -> 301 h closed: the curves cross on the flank segment; optimal's QM stays within twice
+    # normal mapping's (its samples include the uniform map's position of every start).
+    require_limb()
+    c1, c2 = (mm.make_simple(outline(h))[0] for h in (300, 301))
+    normal = mm.quality(mm.map_curves(c1, c2, "normal"), c1, c2)
+    optimal = mm.quality(mm.map_curves(c1, c2, "optimal"), c1, c2)
+    assert normal.crossings == optimal.crossings == 0
+    assert optimal.qm <= 2 * normal.qm
+
+
+def test_default_on_the_long_open_jump_is_within_1_5_of_best():
+    # 250 -> 270 h open: the traced tip's last point doubles back, so only a field whose last
+    # vectors share C2's end point is crossing-free; optimal finds it and the default takes it.
+    require_limb()
+    c1, c2 = (mm.make_simple(outline(h), closed=False)[0] for h in (250, 270))
+    default = mm.quality(mm.map_curves(c1, c2, closed=False), c1, c2, closed=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        best = mm.quality(mm.map_curves(c1, c2, "best", closed=False), c1, c2, closed=False)
+    assert default.crossings == best.crossings == 0
+    assert default.qm <= 1.5 * best.qm

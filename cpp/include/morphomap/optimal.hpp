@@ -13,10 +13,10 @@ namespace morphomap {
 constexpr double kDefaultStretchWeight = 10.0;
 
 struct MonotoneMatch {
-  Vector arcs;          // arc position of each end along the target, strictly increasing
+  Vector arcs;          // arc position of each end along the target, increasing (below)
   Points2 points;       // the end points on the target
   double energy = 0.0;  // the minimised energy (below)
-  Index samples = 0;    // M: the target was sampled at M + 1 equally spaced positions
+  Index samples = 0;    // M: the finest level's equally spaced samples number M + 1 (below)
   // Every vector lies inside the region between the pieces, a simple polygon, so none can cross
   // another (below); false: a matching found otherwise, counted to have no crossings.
   bool by_construction = false;
@@ -27,7 +27,9 @@ struct MonotoneMatch {
 // are the ends of the pieces and correspond (virtual vectors source.row(0) -> target.row(0) and
 // source.row(last) -> target.row(last); a start point that is row 0 or the last row is pinned to
 // the target's end). Ends are chosen among M + 1 equally spaced target positions t_k = k L / M,
-// M = max(4 (n + 1), min(target vertices, 8 (n + 1))), strictly increasing, minimising
+// M = max(4 (n + 1), min(target vertices, 8 (n + 1))), joined by the uniform map's position
+// alpha s_i of each start and, on a target with an edge over 4 times its median, by M - 1
+// positions spaced evenly through its vertices; strictly increasing, minimising
 //
 //   E = sum_i |p_i - q_i|^2 / g^2  +  w * sum_pairs (L_j / (alpha l_j) - 1)^2
 //
@@ -36,7 +38,7 @@ struct MonotoneMatch {
 // length (so that the uniform map has no stretch), g^2 the mean squared distance from the starts
 // to the target (at least the squared mean spacing of the starts, so that touching pieces stay
 // well posed), w = stretch_weight (the paper's QM1 term; 0: nearest monotone matching).
-// Each step advances by 1 .. 8 M / (n + 1) + 2 samples.
+// Each step advances by 1 .. 8 M' / (n + 1) + 2 samples (M' + 1 of them in all).
 //
 // The region, a hard constraint: the pieces and the two end vectors bound a region (whole closed
 // curves: the ring between them cut along the first vector). A vector p_i -> q_k may be taken only
@@ -47,7 +49,11 @@ struct MonotoneMatch {
 //
 // What is guaranteed, and when:
 // - Always: the order. Ends strictly increase along the target (bijective at the sampling), the
-//   pieces' ends are pinned, so every stretch of the target lies between two ends.
+//   pieces' ends are pinned, so every stretch of the target lies between two ends. One exception:
+//   where the source doubles back next to a pinned end or an end vector (a traced tip whose last
+//   point lies back across the one before), every strictly increasing path crosses that vector;
+//   the free rows between it and a row crossing it then share its end point, if that leaves fewer
+//   crossings (never among free rows alone).
 // - No two vectors of the result cross (crossing_pairs: no common point but a shared end), nor
 //   cross the end vectors:
 //   * by construction (by_construction) where the region is the inside of a simple polygon (the

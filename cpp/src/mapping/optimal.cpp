@@ -91,30 +91,40 @@ struct Level {
   std::vector<Index> first;
 };
 
-// The arc positions of M + 1 target samples. Equally spaced on a target whose edges are about
-// even (none longer than kUneven times the median). On an uneven one, each the mean of an equally
-// spaced position and the position the same fraction of the way through the target's vertices:
-// outlines are traced densely where they have detail and sparsely along long edges (a flank closed
-// by one segment), equally spaced samples alone are coarser than the points there, and the stretch
-// term, which compares arc lengths between neighbours, then only sees multiples of the sample step
-// (bench/README.md, "Real 2D outlines"). Strictly increasing; the ends exact.
-std::vector<double> sample_arcs(const Problem& p, Index samples) {
+// The arc positions of the target samples of one level, strictly increasing, the ends exact
+// (positions within 1e-9 of the target's length of a kept one dropped):
+// - M + 1 equally spaced ones;
+// - on a target with uneven edges (one longer than kUneven times the median), also M - 1 at the
+//   same fractions of the way through the target's vertices: outlines are traced densely where
+//   they have detail and sparsely along long edges (a flank closed by one segment), equally spaced
+//   samples alone are coarser than the points there, and the stretch term, which compares arc
+//   lengths between neighbours, then only sees multiples of the sample step. Taking both rather
+//   than their mean maps fingers 5 and 6 long (tests/test_optimal.py);
+// - the uniform map's position alpha * s of each of the level's starts, where the stretch term
+//   is zero: a start a hair from a piece's end on a long target edge (the limb's flank, where the
+//   curves cross on it) otherwise lands a whole sample step away; limb 300 -> 301 h closed went
+//   from QM 14 to 0.0013 (bench/README.md, "Real 2D outlines").
+std::vector<double> sample_arcs(const Problem& p, Index samples, const std::vector<Index>& rows) {
   std::vector<double> t(samples + 1);
-  const Index last_vertex = static_cast<Index>(p.vertex_arcs.size()) - 1;
-  for (Index k = 0; k <= samples; ++k) {
-    const double u = static_cast<double>(k) / static_cast<double>(samples);
-    if (!p.uneven_target) {
-      t[k] = u * p.target_length;
-      continue;
+  for (Index k = 0; k <= samples; ++k) t[k] = static_cast<double>(k) / static_cast<double>(samples) * p.target_length;
+  if (p.uneven_target) {
+    const Index last_vertex = static_cast<Index>(p.vertex_arcs.size()) - 1;
+    for (Index k = 1; k < samples; ++k) {
+      const double x = static_cast<double>(k) / static_cast<double>(samples) * static_cast<double>(last_vertex);
+      const Index j = std::min<Index>(static_cast<Index>(x), last_vertex - 1);
+      const double f = x - static_cast<double>(j);
+      t.push_back(p.vertex_arcs[j] + f * (p.vertex_arcs[j + 1] - p.vertex_arcs[j]));
     }
-    const double x = u * static_cast<double>(last_vertex);
-    const Index j = std::min<Index>(static_cast<Index>(x), last_vertex - 1);
-    const double f = x - static_cast<double>(j);
-    const double through_vertices = p.vertex_arcs[j] + f * (p.vertex_arcs[j + 1] - p.vertex_arcs[j]);
-    t[k] = 0.5 * (u * p.target_length + through_vertices);
   }
-  t[0] = 0.0, t[samples] = p.target_length;
-  return t;
+  for (const Index r : rows) t.push_back(p.alpha * p.s[r]);
+  std::sort(t.begin(), t.end());
+  const double apart = 1e-9 * p.target_length;
+  std::vector<double> kept{0.0};
+  for (const double a : t) {
+    if (a - kept.back() > apart && p.target_length - a > apart) kept.push_back(a);
+  }
+  kept.push_back(p.target_length);
+  return kept;
 }
 
 // The index of the sample nearest to arc position a.
@@ -300,7 +310,8 @@ bool solve_levels(const Problem& p, const std::vector<std::vector<Index>>& level
     const bool finest_level = level_rows + 1 == levels.rend();
     const Index count = static_cast<Index>(level.rows.size());
     level.samples = std::max(4 * (count + 1), (finest * (count + 1) + n) / (n + 1));
-    level.arcs = sample_arcs(p, level.samples);
+    level.arcs = sample_arcs(p, level.samples, level.rows);
+    level.samples = static_cast<Index>(level.arcs.size()) - 1;
     const std::vector<double> centre =
         coarse_rows.empty() ? std::vector<double>() : carry(p, coarse_rows, coarse_t, level.rows);
     const Index first_band = std::max<Index>(16, 8 * level.samples / (count + 1));
@@ -342,6 +353,61 @@ bool solve_levels(const Problem& p, const std::vector<std::vector<Index>>& level
     for (Index r = 0; r < count; ++r) coarse_t[r] = level.arcs[path[r]];
   }
   return true;
+}
+
+// Where the source doubles back next to a piece's end (a traced tip whose last point lies back
+// across the one before it), every strictly increasing path crosses that end's vector: a
+// crossing-free order-preserving field exists only with the rows between sharing its end point.
+// For each crossing pair of rows a < b of which one is fixed (a pinned row, or an end vector as
+// row -1 or n; `starts` holds the starts and then the end vectors, in virtual_rows' order), the
+// free rows from the other one up to it take its end, if that leaves fewer crossings; the ends
+// then increase along the target but not strictly there. Crossings among free rows are left (a
+// field that collapsed them would not be the bijective matching optimal.hpp promises). Returns
+// the crossings left.
+Index merge_crossing_ends(const Problem& p, const Points2& starts, const std::vector<Index>& virtual_rows,
+                          MonotoneMatch& match) {
+  const Index n = match.points.rows();
+  auto fixed = [&](Index r) { return r < 0 || r >= n || (r == 0 && p.pinned_first) || (r == n - 1 && p.pinned_last); };
+  auto end_of = [&](Index r) -> std::pair<double, Vec2> {
+    if (r < 0) return {0.0, p.begin_target};
+    if (r >= n) return {p.target_length, p.end_target};
+    return {match.arcs[r], match.points.row(r).transpose()};
+  };
+  auto ends_of = [&](const MonotoneMatch& m) {
+    Points2 ends(starts.rows(), 2);
+    ends.topRows(n) = m.points;
+    for (std::size_t e = 0; e < virtual_rows.size(); ++e) {
+      ends.row(n + static_cast<Index>(e)) = (virtual_rows[e] < 0 ? p.begin_target : p.end_target).transpose();
+    }
+    return ends;
+  };
+  auto row_of = [&](Index index) { return index < n ? index : virtual_rows[index - n]; };
+  std::vector<std::pair<Index, Index>> pairs = crossing_pairs(starts, ends_of(match));
+  while (!pairs.empty()) {
+    Index left = static_cast<Index>(pairs.size());
+    MonotoneMatch chosen;
+    for (const auto& [i, j] : pairs) {
+      const Index a = std::min(row_of(i), row_of(j)), b = std::max(row_of(i), row_of(j));
+      for (const bool forward : {true, false}) {
+        if (forward ? fixed(a) || !fixed(b) : fixed(b) || !fixed(a)) continue;
+        MonotoneMatch merged = match;
+        const auto [arc, point] = end_of(forward ? b : a);
+        for (Index r = forward ? a : a + 1; r <= (forward ? b - 1 : b); ++r) {
+          if (r < 0 || r >= n) continue;
+          merged.arcs[r] = arc;
+          merged.points.row(r) = point.transpose();
+        }
+        const Index count = count_crossings(starts, ends_of(merged));
+        if (count < left) left = count, chosen = std::move(merged);
+      }
+      if (left == 0) break;
+    }
+    if (left == static_cast<Index>(pairs.size())) break;  // no merge helps
+    match = std::move(chosen);
+    match.by_construction = false;
+    pairs = crossing_pairs(starts, ends_of(match));
+  }
+  return static_cast<Index>(pairs.size());
 }
 
 }  // namespace
@@ -437,6 +503,11 @@ MonotoneMatch detail::monotone_match_unchecked(const Points2Ref& source, const s
   Points2 starts(n + static_cast<Index>(from.size()), 2);
   starts.topRows(n) = p.starts;
   for (std::size_t e = 0; e < from.size(); ++e) starts.row(n + static_cast<Index>(e)) = from[e].transpose();
+  // Row of the path that each vector after the n starts' own stands for: -1 before the first, n
+  // after the last.
+  std::vector<Index> virtual_rows;
+  if (!p.pinned_first) virtual_rows.push_back(-1);
+  if (!p.pinned_last && !one_vector) virtual_rows.push_back(n);
   // The path's ends and an exact count of its crossings.
   std::vector<double> coarse_t;
   double energy = 0.0;
@@ -483,6 +554,7 @@ MonotoneMatch detail::monotone_match_unchecked(const Points2Ref& source, const s
     solve_levels(p, levels, finest, start_rows, coarse_t, energy);
     crossings = take();
   }
+  if (crossings > 0) crossings = merge_crossing_ends(p, starts, virtual_rows, match);
   if (crossings > 0) {
     throw GeometryError("optimal: no crossing-free order-preserving matching of a pair of pieces (" +
                         (why_not.empty() ? std::string("its ends are fixed") : why_not) +
