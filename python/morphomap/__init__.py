@@ -34,14 +34,15 @@ from .io import (
     write_interior,
     write_surface,
 )
-from .mapping import PreparedCurve, map_curves
+from .mapping import map_curves
 from .plot import plot_field, plot_field_3d
 from .quality import CurveQuality, SurfaceQuality, quality
 from .batch import Job, map_batch
 from .series import Series, map_series
 from .simple import make_simple
 from .queries import CurveHits, CurveIndex, closest_points, line_intersections
-from .surfaces import PreparedSurface, SurfaceHits, SurfaceIndex, map_surfaces, remesh_surface, surface_normals
+from .prepared import PreparedCurve, PreparedSurface
+from .surfaces import SurfaceHits, SurfaceIndex, map_surfaces, remesh_surface, surface_normals
 from .transform import Similarity, align_curves, overlap_area
 
 __version__ = _build_info()["version"]

@@ -7,7 +7,7 @@ import numpy as np
 
 from ._validate import as_points
 from .curves import signed_area
-from .surfaces import as_surface
+from .prepared import as_surface
 
 
 def _loops(points: np.ndarray, gap: float | None) -> list[np.ndarray]:

@@ -9,7 +9,8 @@ import numpy as np
 from . import _core
 from ._progress import StageBar
 from ._validate import as_flag, as_real
-from .surfaces import DIFFUSION_STAGES, as_surface
+from .prepared import as_surface
+from .surfaces import DIFFUSION_STAGES
 
 
 @dataclass(frozen=True)

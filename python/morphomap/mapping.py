@@ -2,14 +2,11 @@
 
 from __future__ import annotations
 
-import warnings
-
-import numpy as np
-
 from . import _core
-from ._validate import as_choice, as_flag, as_integer, as_point, as_points, as_real
+from ._validate import as_choice, as_flag, as_integer, as_point, as_real
 from .field import DisplacementField
-from .simple import map_repaired, repaired_curves, simple_curve
+from .prepared import PreparedCurve, as_curve, repaired_curves
+from .simple import put_back
 
 #: What ``method`` takes: the core's registry (``kMapMethods``), then ``"best"``, which is Python's.
 CURVE_METHODS = tuple(_core.MAP_METHODS) + ("best",)
@@ -40,49 +37,6 @@ def _core_options(n, anchor, density_threshold, contact_tolerance, mesh_size, me
         mesh_fraction=as_real(mesh_fraction, "mesh_fraction", 0.02),
         stretch_weight=as_real(stretch_weight, "stretch_weight", _core.DEFAULT_STRETCH_WEIGHT),
     )
-
-
-class PreparedCurve:
-    """A curve checked and indexed once, for several mappings of it (beyond the paper).
-
-    :func:`map_curves` and :func:`quality` take it wherever they take a curve; given two, they
-    skip their checks (simple: one loop, no self-intersection) and reuse the curves' query
-    indices, with the same results bit for bit. :func:`map_series` prepares each 2D frame once:
-    frame k is the target of one pair and the source of the next.
-
-    Parameters
-    ----------
-    points : (N, 2) float
-        A simple curve, as :func:`map_curves` wants (checked here; copied as given).
-    name : str
-        How error messages name it.
-    closed : bool
-        Whether it is closed; the calls it is passed to must ask for the same (``ValueError``
-        naming the argument otherwise).
-    """
-
-    def __init__(self, points, name: str = "curve", *, closed=True):
-        # A copy, read-only: the core holds its own, and a caller editing the array afterwards must
-        # not leave the two sides of a mixed call on different curves. Finiteness is the core's rule.
-        self.points = np.array(as_points(points, str(name), allow_nan=True), copy=True)
-        self.closed = as_flag(closed, "closed")
-        try:
-            self._prepared = _core.PreparedCurve(self.points, self.closed, str(name))
-        except ValueError as error:
-            # As map_curves: a traced contour is kept as make_simple repairs it, with a warning.
-            points, changes = simple_curve(self.points, self.closed, str(name))
-            if not changes:
-                raise error from None
-            warnings.warn(f"{name}: prepared as morphomap.make_simple makes it simple (pass its result to "
-                          f"silence this): {changes}", UserWarning, stacklevel=2)
-            self.points = points
-            self._prepared = _core.PreparedCurve(self.points, self.closed, str(name))
-        self.points.flags.writeable = False
-
-
-def as_curve(value, name: str, *, allow_nan: bool = False) -> np.ndarray:
-    """The points of a curve given as an array or as a :class:`PreparedCurve`."""
-    return value.points if isinstance(value, PreparedCurve) else as_points(value, name, allow_nan=allow_nan)
 
 
 def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, transform=False,
@@ -246,6 +200,24 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
     except ValueError as error:
         # Not simple: a contour as traced (necks, spurs, repeats) is mapped as make_simple repairs
         # it, with a warning; anything else raises. Simple curves pay nothing for this.
-        return map_repaired(error, c1, c2, closed, lambda a, b: DisplacementField._from_core(
+        return _map_repaired(error, c1, c2, closed, lambda a, b: DisplacementField._from_core(
             _core.map_curves(a, b, method, closed, **flags), source=a, closed=closed))
     return DisplacementField._from_core(record, source=source, closed=closed)
+
+
+def _map_repaired(error: ValueError, c1, c2, closed: bool, run):
+    """After the core refused ``c1`` or ``c2`` with ``error``: map them as :func:`make_simple`
+    makes them with ``run(c1, c2)`` (a :class:`DisplacementField` from arrays) and put the field
+    back onto the curves as given (:func:`morphomap.simple.put_back`), or raise ``error`` again
+    where neither changes."""
+    try:
+        repaired, changes = repaired_curves(c1, c2, closed, stacklevel=3)
+    except ValueError as refusal:
+        # The core's message first (it counts the loops or the meeting pairs), then why the repair
+        # does not apply, where that says more (a curve of too few points is refused alike).
+        if str(refusal) == str(error):
+            raise error from None
+        raise ValueError(f"{error} (morphomap.make_simple does not repair it either: {refusal})") from None
+    if all(change is None for change in changes):
+        raise error
+    return put_back(run(*repaired), c1, c2, repaired, changes, closed)

@@ -9,8 +9,7 @@ import numpy as np
 from . import _core
 from ._validate import as_flag
 from .field import DisplacementField
-from .mapping import PreparedCurve, as_curve
-from .surfaces import PreparedSurface, as_surface
+from .prepared import PreparedCurve, PreparedSurface, as_curve, as_surface
 
 
 @dataclass(frozen=True)

@@ -264,9 +264,11 @@ def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **op
     from ._core import GeometryError
     from ._validate import as_length
     from .carry import IndexedCurve, carry_curve, carry_surface
-    from .mapping import PreparedCurve, map_curves
+    from .mapping import map_curves
+    from .prepared import PreparedCurve
     from .quality import quality
-    from .surfaces import PreparedSurface, SurfaceIndex, as_surface, map_surfaces
+    from .prepared import PreparedSurface, as_surface
+    from .surfaces import SurfaceIndex, map_surfaces
 
     frames = list(frames)
     if len(frames) < 2:

@@ -46,14 +46,16 @@ back unchanged, bit for bit, with no changes, at the cost of one check.
 from __future__ import annotations
 
 import math
-import warnings
 from typing import NamedTuple
 
 import numpy as np
 
 from . import _core
 from ._validate import as_flag, as_points
+from .crossings import count_crossings
 from .curves import signed_area
+from .field import DisplacementField
+from .queries import closest_points
 
 #: How far each visit of a neck point is moved, relative to the median point spacing.
 NECK_OPENING = 1e-6
@@ -388,55 +390,15 @@ class _Repair:
             "(check the segmentation; morphomap.split_components separates stacked contours)")
 
 
-def repaired_curves(c1, c2, closed: bool, stacklevel: int):
-    """``c1`` and ``c2`` as :func:`make_simple` makes them (a :class:`~morphomap.PreparedCurve`
-    is simple already and stays as it is), with one ``UserWarning`` naming each curve repaired
-    and what was changed; and the changes, ``None`` for a curve left as it was.
-
-    Raises ``ValueError`` naming ``c1`` or ``c2`` where one meets itself genuinely."""
-    from .mapping import PreparedCurve
-
-    curves, changes, told = [], [], []
-    for value, name in ((c1, "c1"), (c2, "c2")):
-        if isinstance(value, PreparedCurve):
-            curves.append(value)
-            changes.append(None)
-            continue
-        points, changed = simple_curve(value, closed, name)
-        curves.append(points if changed else value)
-        changes.append(changed if changed else None)
-        if changed:
-            told.append(f"{name}: {changed}")
-    if told:
-        warnings.warn("mapped the curves as morphomap.make_simple makes them simple (pass its result to silence "
-                      "this): " + "; ".join(told), UserWarning, stacklevel=stacklevel + 1)
-    return curves, changes
-
-
-def map_repaired(error: ValueError, c1, c2, closed: bool, run):
-    """After the core refused ``c1`` or ``c2`` with ``error``: map them as :func:`make_simple`
-    makes them with ``run(c1, c2)`` (a :class:`~morphomap.DisplacementField` from arrays), or
-    raise ``error`` again where neither changes.
-
-    The field is then put back onto the curves as given, unless that adds crossings: start
-    points the repair had moved (a neck's visits, a first point across the closing segment) where
-    ``c1`` has them, and split points inserted on a segment that the seam repair moved (farther
-    from ``c1`` than a neck's opening: not points of ``c1``) dropped; ends at their closest point
-    of ``c2`` (they move by at most what the repair moved ``c2``)."""
-    from .crossings import count_crossings
-    from .field import DisplacementField
-
-    try:
-        (r1, r2), (changes1, changes2) = repaired_curves(c1, c2, closed, stacklevel=3)
-    except ValueError as refusal:
-        # The core's message first (it counts the loops or the meeting pairs), then why the repair
-        # does not apply, where that says more (a curve of too few points is refused alike).
-        if str(refusal) == str(error):
-            raise error from None
-        raise ValueError(f"{error} (morphomap.make_simple does not repair it either: {refusal})") from None
-    if changes1 is None and changes2 is None:
-        raise error
-    field = run(r1, r2)
+def put_back(field, c1, c2, repaired, changes, closed: bool):
+    """The ``field`` mapped between the ``repaired`` curves (``(r1, r2)``, as :func:`make_simple`
+    made ``c1`` and ``c2``, with their ``changes``, ``None`` for a curve left as it was) put back
+    onto the curves as given, unless that adds crossings: start points the repair had moved (a
+    neck's visits, a first point across the closing segment) where ``c1`` has them, and split
+    points inserted on a segment that the seam repair moved (farther from ``c1`` than a neck's
+    opening: not points of ``c1``) dropped; ends at their closest point of ``c2`` (they move by
+    at most what the repair moved ``c2``)."""
+    (r1, r2), (changes1, changes2) = repaired, changes
     starts, ends, method = np.array(field.starts), np.array(field.ends), field.method
     source = r1
     if changes1 is not None:
@@ -459,8 +421,6 @@ def _back_onto(points, repaired, kept, given, closed, *, snap=False):
     a point equal to a repaired vertex that moved goes where that vertex was (``kept``: the given
     rows the repair kept); the others go to their closest point of ``given``: all with ``snap``,
     else those within a neck's opening of it. Returns which points are on ``given`` now."""
-    from .queries import closest_points
-
     moved = np.zeros(len(points), dtype=bool)
     for k in np.flatnonzero(np.any(kept != repaired, axis=1)):
         at = np.all(points == repaired[k], axis=1)

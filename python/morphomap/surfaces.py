@@ -10,6 +10,7 @@ from . import _core
 from ._progress import StageBar, as_progress
 from ._validate import as_choice, as_faces, as_flag, as_integer, as_points, as_real
 from .field import DisplacementField
+from .prepared import PreparedSurface, as_surface
 
 #: What ``method`` takes: the methods with a 3D form in the core's method table, then ``"best"``,
 #: which is Python's.
@@ -17,22 +18,6 @@ SURFACE_METHODS = tuple(row.name for row in _core.METHODS if row.surfaces) + ("b
 # The stages the core reports (SurfaceMappingOptions::on_stage), in order, for the progress bar.
 DIFFUSION_STAGES = ("mesh", "solve", "trace")
 _STAGES = {"diffusion": DIFFUSION_STAGES, "auto": ("normal",) + DIFFUSION_STAGES}
-
-
-def as_surface(value, name: str, *, core_checks: bool = False) -> tuple[np.ndarray, np.ndarray]:
-    """Return ``(vertices, faces)`` of a ``trimesh.Trimesh`` or a ``(vertices, faces)`` pair.
-
-    ``core_checks``: the values go to the core's ``check_closed_surface``, which checks that the
-    vertices are finite and the face indices in range with the same messages; only types and
-    shapes are checked here. Otherwise they are checked here."""
-    if hasattr(value, "vertices") and hasattr(value, "faces") and not isinstance(value, (tuple, list)):
-        vertices, faces = value.vertices, value.faces
-    elif isinstance(value, (tuple, list)) and len(value) == 2:
-        vertices, faces = value
-    else:
-        raise TypeError(f"{name}: expected a trimesh.Trimesh or a (vertices, faces) pair, got {type(value).__name__}")
-    vertices = as_points(vertices, f"{name} vertices", 3, allow_nan=core_checks)
-    return vertices, as_faces(faces, f"{name} faces", None if core_checks else len(vertices))
 
 
 class SurfaceHits(NamedTuple):
@@ -83,31 +68,6 @@ class SurfaceIndex:
         origins = as_points(origins, "origins", 3)
         directions = as_points(directions, "directions", 3)
         return SurfaceHits(**self._index.line_intersections(origins, directions))
-
-
-class PreparedSurface:
-    """A closed surface checked and indexed once, for several mappings of it (beyond the paper).
-
-    :func:`map_surfaces` and :func:`quality` take it wherever they take a surface; given two, they
-    skip their checks (closed, oriented outwards) and reuse the surfaces' Embree scenes, with the
-    same results bit for bit. :func:`map_series` prepares each frame once: frame k is the target of
-    one pair and the source of the next.
-
-    Parameters
-    ----------
-    surface : trimesh.Trimesh or (vertices (V, 3) float, faces (F, 3) int)
-        Closed with outward faces, as :func:`map_surfaces` wants (checked here, by the core; copied).
-    name : str
-        How error messages name it.
-    """
-
-    def __init__(self, surface, name: str = "surface"):
-        # Copies, read-only: the core holds its own, and a caller editing the mesh afterwards must not
-        # leave the two sides of a mixed call on different surfaces.
-        converted = as_surface(surface, name, core_checks=True)  # the core checks them (below)
-        self.vertices, self.faces = (np.array(array, copy=True) for array in converted)
-        self.vertices.flags.writeable = self.faces.flags.writeable = False
-        self._prepared = _core.PreparedSurface(self.vertices, self.faces, str(name))
 
 
 def surface_normals(vertices, faces) -> np.ndarray:

@@ -7,7 +7,7 @@ import os
 import numpy as np
 
 from .. import _core
-from ..surfaces import as_surface
+from ..prepared import as_surface
 from .atomic import atomic_path
 
 SURFACE_SUFFIXES = (".stl", ".ply", ".obj", ".off")
