@@ -38,6 +38,7 @@ from .mapping import map_curves
 from .plot import plot_field, plot_field_3d
 from .quality import CurveQuality, SurfaceQuality, quality
 from .batch import Job, map_batch
+from . import best  # noqa: F401  (registers method "best" with map_curves and map_surfaces)
 from .series import Series, map_series
 from .simple import make_simple
 from .queries import CurveHits, CurveIndex, closest_points, line_intersections

@@ -52,7 +52,15 @@ from typing import NamedTuple
 
 import numpy as np
 
+from . import _core
 from ._validate import as_count, as_flag, as_points
+from .chooser import CHOOSERS
+from .field import DisplacementField
+from .mapping import as_contact_tolerance, map_curves
+from .prepared import as_surface
+from .quality import quality
+from .queries import closest_points
+from .surfaces import map_surfaces
 
 #: Default of ``skip_below``: see the module's documentation.
 SKIP_BELOW = 1e-3
@@ -174,11 +182,6 @@ _FIXED_FROM = ("normal", "minimal_distance", "optimal", "auto")
 
 def _per_piece(results, split, c1, c2, closed):
     """The per-piece choice: ((field, Candidate "per_piece") or None, [PieceCandidate])."""
-    from . import _core
-    from .field import DisplacementField
-    from .quality import quality
-    from .queries import closest_points
-
     begin = time.perf_counter()
     ran = [(field, c) for field, c in results if field is not None]
     labels = []
@@ -263,10 +266,6 @@ def map_best(c1, c2, *, closed=True, n=None, split=True, anchor=None, density_th
              contact_tolerance=None, mesh_size=None, mesh_fraction=0.02, stretch_weight=None,
              skip_below=None, workers=None):
     """2D ``method="best"``: see the module's documentation. Called by :func:`map_curves`."""
-    from . import _core
-    from .mapping import as_contact_tolerance, map_curves
-    from .quality import quality
-
     options = dict(closed=closed, n=n, split=split, anchor=anchor, contact_tolerance=contact_tolerance,
                    mesh_size=mesh_size, mesh_fraction=mesh_fraction)
 
@@ -297,9 +296,6 @@ def map_best(c1, c2, *, closed=True, n=None, split=True, anchor=None, density_th
 def map_best_surfaces(s1, s2, *, mesh_size=None, repeatable=True, skip_below=None, workers=None):
     """3D ``method="best"``: see the module's documentation; the pair is one subproblem (no
     per-piece choice, no ``piece_candidates``). Called by :func:`map_surfaces`."""
-    from .quality import quality
-    from .surfaces import as_surface, map_surfaces
-
     s1, s2 = as_surface(s1, "s1"), as_surface(s2, "s2")
 
     def job(name, method, reverse=False, transform=False):
@@ -329,3 +325,6 @@ def candidate_table(field, *, pieces=False) -> str:
                          f"{c.seconds:.3f}", c.status))
     widths = np.max([[len(x) for x in row] for row in rows], axis=0)
     return "\n".join("  ".join(x.ljust(w) for x, w in zip(row, widths)).rstrip() for row in rows)
+
+
+CHOOSERS.update(curves=map_best, surfaces=map_best_surfaces)

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 from . import _core
 from ._validate import as_choice, as_flag, as_integer, as_point, as_real
+from .chooser import BEST, CHOOSERS
 from .field import DisplacementField
 from .prepared import PreparedCurve, as_curve, repaired_curves
 from .simple import put_back
 
 #: What ``method`` takes: the core's registry (``kMapMethods``), then ``"best"``, which is Python's.
-CURVE_METHODS = tuple(_core.MAP_METHODS) + ("best",)
+CURVE_METHODS = tuple(_core.MAP_METHODS) + (BEST,)
 
 
 def as_contact_tolerance(value) -> float:
@@ -170,22 +171,21 @@ def map_curves(c1, c2, method="auto", *, closed=True, n=None, reverse=False, tra
     """
     closed = as_flag(closed, "closed")
     method = as_choice(method, "method", CURVE_METHODS)
-    if method == "best":
-        from .best import map_best
-
+    if method == BEST:
         if as_flag(reverse, "reverse") or as_flag(transform, "transform"):
-            raise ValueError("reverse/transform: method 'best' tries the reversed and transformed forms itself; "
+            raise ValueError(f"reverse/transform: method {BEST!r} tries the reversed and transformed forms itself; "
                              "leave both False")
         # Checked here, as a candidate that refuses an option would only drop out of the choice.
         _core.validate_options(closed, **_core_options(n, anchor, density_threshold, contact_tolerance, mesh_size,
                                                         mesh_fraction, stretch_weight))
         (c1, c2), _ = repaired_curves(c1, c2, closed, stacklevel=2)
-        return map_best(as_curve(c1, "c1"), as_curve(c2, "c2"), closed=closed, n=n, split=split, anchor=anchor,
-                        density_threshold=density_threshold, contact_tolerance=contact_tolerance,
-                        mesh_size=mesh_size, mesh_fraction=mesh_fraction, stretch_weight=stretch_weight,
-                        skip_below=skip_below, workers=workers)
+        return CHOOSERS["curves"](as_curve(c1, "c1"), as_curve(c2, "c2"), closed=closed, n=n, split=split,
+                                  anchor=anchor, density_threshold=density_threshold,
+                                  contact_tolerance=contact_tolerance, mesh_size=mesh_size,
+                                  mesh_fraction=mesh_fraction, stretch_weight=stretch_weight, skip_below=skip_below,
+                                  workers=workers)
     if skip_below is not None or workers is not None:
-        raise ValueError("skip_below/workers: only for method 'best'")
+        raise ValueError(f"skip_below/workers: only for method {BEST!r}")
     options = _core_options(n, anchor, density_threshold, contact_tolerance, mesh_size, mesh_fraction, stretch_weight)
     # Finiteness is the core's rule (require_curve, the same message): converted only here.
     source = as_curve(c1, "c1", allow_nan=True)

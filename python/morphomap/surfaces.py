@@ -9,12 +9,13 @@ import numpy as np
 from . import _core
 from ._progress import StageBar, as_progress
 from ._validate import as_choice, as_faces, as_flag, as_integer, as_points, as_real
+from .chooser import BEST, CHOOSERS
 from .field import DisplacementField
 from .prepared import PreparedSurface, as_surface
 
 #: What ``method`` takes: the methods with a 3D form in the core's method table, then ``"best"``,
 #: which is Python's.
-SURFACE_METHODS = tuple(row.name for row in _core.METHODS if row.surfaces) + ("best",)
+SURFACE_METHODS = tuple(row.name for row in _core.METHODS if row.surfaces) + (BEST,)
 # The stages the core reports (SurfaceMappingOptions::on_stage), in order, for the progress bar.
 DIFFUSION_STAGES = ("mesh", "solve", "trace")
 _STAGES = {"diffusion": DIFFUSION_STAGES, "auto": ("normal",) + DIFFUSION_STAGES}
@@ -181,18 +182,16 @@ def map_surfaces(s1, s2, method="auto", *, reverse=False, mesh_size=None, repeat
     reverse = as_flag(reverse, "reverse")
     repeatable = as_flag(repeatable, "repeatable")  # before "best" runs its candidates
     progress = as_progress(progress)
-    if method == "best":
-        from .best import map_best_surfaces
-
+    if method == BEST:
         if progress:
-            raise ValueError("progress: method 'best' runs its candidates side by side and shows no bar; "
+            raise ValueError(f"progress: method {BEST!r} runs its candidates side by side and shows no bar; "
                              "leave it None or False")
         if reverse:
-            raise ValueError("reverse: method 'best' tries the reversed forms itself; leave it False")
-        return map_best_surfaces(s1, s2, mesh_size=mesh_size, repeatable=repeatable, skip_below=skip_below,
-                                 workers=workers)
+            raise ValueError(f"reverse: method {BEST!r} tries the reversed forms itself; leave it False")
+        return CHOOSERS["surfaces"](s1, s2, mesh_size=mesh_size, repeatable=repeatable, skip_below=skip_below,
+                                    workers=workers)
     if skip_below is not None or workers is not None:
-        raise ValueError("skip_below/workers: only for method 'best'")
+        raise ValueError(f"skip_below/workers: only for method {BEST!r}")
     prepared = isinstance(s1, PreparedSurface) and isinstance(s2, PreparedSurface)
     if not prepared:
         v1, f1 = as_surface(s1, "s1", core_checks=True)
