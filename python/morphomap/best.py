@@ -97,14 +97,46 @@ def _name(method: str, reverse: bool, transform: bool) -> str:
     return ("transformed_" if transform else "") + ("reverse_" if reverse else "") + method
 
 
-def _plan(methods, transforms):
-    """[(name, method, reverse, transform)] in the order of the table."""
-    plan = []
-    for transform in transforms:
-        for method in methods:
-            for reverse in (False, True):
-                plan.append((_name(method, reverse, transform), method, reverse, transform))
-    return plan
+# The core's method table has no column for what a candidate costs or for which one leads a tie,
+# so these are the only method names written here; every other choice below reads the table.
+#: The candidate that comes first in its batch, so that ties go to it: the paper's first choice
+#: (normal mapping leads its Algorithm 1).
+_LEADS = "normal"
+#: The algorithm that solves a Laplace problem: seconds, where the others take milliseconds.
+_SOLVES_PDE = "diffusion"
+
+
+def _plan(form: str, transforms):
+    """best's candidates for ``form`` (``"curves"``, ``"surfaces"``) from the core's method table,
+    as ``(cheap, expensive)``, each ``[(name, method, reverse, transform)]`` in the order of the
+    candidate table: the basic algorithms that both forms have, each plain and, having a reversed
+    form, reversed, for each of ``transforms`` (normal mapping first); then the form's basic
+    algorithms beyond the paper, plain; then its workflows beyond the paper (the default). The
+    ones that solve a Laplace problem are the expensive batch."""
+    rows = [row for row in _core.METHODS if getattr(row, form)]
+    common = sorted((row for row in rows if row.basic and row.curves and row.surfaces),
+                    key=lambda row: row.name != _LEADS)
+
+    def variants(group):
+        return [(_name(row.name, reverse, transform), row.name, reverse, transform)
+                for transform in transforms for row in group
+                for reverse in ((False, True) if row.backward else (False,))]
+
+    beyond = [row for row in rows if not row.from_paper]
+    plain = [(row.name, row.name, False, False) for row in beyond if row.basic]
+    plain += [(row.name, row.name, False, False) for row in beyond if not row.basic]
+    return (variants([row for row in common if row.name != _SOLVES_PDE]) + plain,
+            variants([row for row in common if row.name == _SOLVES_PDE]))
+
+
+#: The candidates of each dimension: 2D with and without Appendix A's transform, 3D without.
+_CURVE_PLAN = _plan("curves", (False, True))
+_SURFACE_PLAN = _plan("surfaces", (False,))
+#: The options that only some candidates are given: ``density_threshold`` the workflows (the
+#: paper's density rule), ``stretch_weight`` the basic algorithms beyond the paper (the
+#: order-preserving matching's weight; the default's own matching keeps its default).
+_TAKES = {row.name: {"density_threshold": not row.basic, "stretch_weight": row.basic and not row.from_paper}
+          for row in _core.METHODS}
 
 
 def _run(job):
@@ -176,8 +208,8 @@ def _choose(cheap, expensive, skip_below, workers):
     return _pick(_run_all(cheap, expensive, skip_below, workers))
 
 
-#: Forward, untransformed candidates: their vectors at the split points are the split's own.
-_FIXED_FROM = ("normal", "minimal_distance", "optimal", "auto")
+#: Forward, untransformed cheap candidates: their vectors at the split points are the split's own.
+_FIXED_FROM = frozenset(name for name, _, reverse, transform in _CURVE_PLAN[0] if not (reverse or transform))
 
 
 def _per_piece(results, split, c1, c2, closed):
@@ -269,16 +301,14 @@ def map_best(c1, c2, *, closed=True, n=None, split=True, anchor=None, density_th
     options = dict(closed=closed, n=n, split=split, anchor=anchor, contact_tolerance=contact_tolerance,
                    mesh_size=mesh_size, mesh_fraction=mesh_fraction)
 
+    given = {"density_threshold": density_threshold, "stretch_weight": stretch_weight}
+
     def job(name, method, reverse=False, transform=False):
-        extra = {"density_threshold": density_threshold} if method == "auto" else {}
-        if method == "optimal":
-            extra["stretch_weight"] = stretch_weight
+        extra = {option: value for option, value in given.items() if _TAKES[method][option]}
         return (name, lambda: map_curves(c1, c2, method, reverse=reverse, transform=transform, **options, **extra),
                 lambda field: quality(field, c1, c2, closed=closed))
 
-    cheap = [job(*row) for row in _plan(("normal", "minimal_distance"), (False, True))]
-    cheap += [job("optimal", "optimal"), job("auto", "auto")]
-    expensive = [job(*row) for row in _plan(("diffusion",), (False, True))]
+    cheap, expensive = ([job(*row) for row in batch] for batch in _CURVE_PLAN)
     results = _run_all(cheap, expensive, skip_below, workers)
     # With n the candidates split the resampled curves: per pair (see above). Without any field
     # _pick says why each candidate failed.
@@ -303,8 +333,7 @@ def map_best_surfaces(s1, s2, *, mesh_size=None, repeatable=True, skip_below=Non
                                            repeatable=repeatable, progress=False),
                 lambda field: quality(field, s1, s2))
 
-    cheap = [job(*row) for row in _plan(("normal", "minimal_distance"), (False,))] + [job("auto", "auto")]
-    expensive = [job(*row) for row in _plan(("diffusion",), (False,))]
+    cheap, expensive = ([job(*row) for row in batch] for batch in _SURFACE_PLAN)
     return _choose(cheap, expensive, skip_below, workers)
 
 

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._core import METHODS, GeometryError
+from ..chooser import BEST
 from ..io import EXAMPLES, load_example, write_curve, write_field
 from ..io.atomic import atomic_text
 from ..mapping import map_curves
@@ -31,7 +32,7 @@ from ..quality import quality
 ALGORITHMS = tuple(row.name for row in METHODS if row.basic and row.from_paper and row.curves)
 VARIANTS = ("plain", "reverse", "transform")
 _VARIANT_ARGUMENTS = {"plain": {}, "reverse": {"reverse": True}, "transform": {"transform": True}}
-_BEYOND_PAPER = tuple(row.name for row in METHODS if row.basic and not row.from_paper and row.curves) + ("best",)
+_BEYOND_PAPER = tuple(row.name for row in METHODS if row.basic and not row.from_paper and row.curves) + (BEST,)
 _VARIANT_TITLES = {"plain": "", "reverse": "reverse ", "transform": "transformed "}
 
 
@@ -181,7 +182,7 @@ def run(out="morphomap-demo", *, pairs=EXAMPLES, stream=None, plots=True) -> lis
             q = quality(field, c1, c2, closed=True)
             rows.append(Row(pair, method, "plain", q.qm1, q.qm2, q.qm, q.crossings, int((~field.valid).sum()),
                             len(field), time.perf_counter() - tick))
-            if method == "best":
+            if method == BEST:
                 winner = next(c.name for c in field.candidates if c.status == "won")
                 if winner == "per_piece":  # the pieces' winners, assembled
                     pieces = [r.name for r in field.piece_candidates if r.status == "won"]
