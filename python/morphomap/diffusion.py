@@ -55,5 +55,4 @@ def solve_diffusion(c1, c2, *, closed=True, mesh_size=None, mesh_fraction=0.02, 
         as_points(c1, "c1"), as_points(c2, "c2"), as_flag(closed, "closed"),
         as_real(mesh_size, "mesh_size", 0.0), as_real(mesh_fraction, "mesh_fraction", 0.02),
         as_flag(streamlines, "streamlines"))
-    return DiffusionSolution(found["vertices"], found["triangles"], found["potential"], found["ends"],
-                             list(found["streamlines"]), dict(found["seconds"]))
+    return DiffusionSolution(**found)

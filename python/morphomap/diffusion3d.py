@@ -102,5 +102,4 @@ def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False, progress=No
         solved = _core.solve_diffusion_3d(v1, f1, v2, f2, size, keep, repeat, bar.callback)
     finally:
         bar.close()
-    return ShellDiffusionSolution(solved["vertices"], solved["tetrahedra"], solved["potential"], solved["ends"],
-                                  solved["touching"], list(solved["streamlines"]), dict(solved["seconds"]))
+    return ShellDiffusionSolution(**solved)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-
 import numpy as np
 
 from . import _core
@@ -60,6 +59,11 @@ class InteriorField:
 
     def __setattr__(self, name, value):
         raise AttributeError("InteriorField is immutable")
+
+    def _with_attempts(self, attempts) -> "InteriorField":
+        """The same field with what :func:`extend_field` tried."""
+        return InteriorField(**{name: getattr(self, name) for name in self.__slots__ if name != "attempts"},
+                             attempts=attempts)
 
     @property
     def dim(self) -> int:
@@ -196,7 +200,7 @@ def extend_field(field, boundary=None, *, method="harmonic", mesh=None, mesh_siz
     attempts, best = [], None
     for steps, tangle in plan:
         try:
-            result = solve(points, cells, steps, tangle)
+            tried = InteriorField(**solve(points, cells, steps, tangle), substeps=steps, untangled=tangle)
         except GeometryError:
             if not attempts:  # the first try: the core's own message (a bad mesh, say)
                 raise
@@ -204,16 +208,15 @@ def extend_field(field, boundary=None, *, method="harmonic", mesh=None, mesh_siz
             attempts.append((steps, tangle, None, float("nan")))
             continue
         if not attempts and mesh is not None:
-            _check_units(result["boundary_distance"], outline, points, tolerance)
-        attempts.append((steps, tangle, int(result["inverted"]), float(result["min_jacobian"])))
-        if best is None or result["inverted"] < best[0]["inverted"]:
-            best = (result, steps, tangle)
-        if result["inverted"] == 0:
+            _check_units(tried.boundary_distance, outline, points, tolerance)
+        attempts.append((steps, tangle, tried.inverted, tried.min_jacobian))
+        if best is None or tried.inverted < best.inverted:
+            best = tried
+        if tried.inverted == 0:
             break
         # The same mesh for the next try (the one made here, or the caller's).
-        points, cells = result["points"], result["cells"]
-    result, steps, tangle = best
-    interior = InteriorField(**result, substeps=steps, untangled=tangle, attempts=attempts)
+        points, cells = tried.points, tried.cells
+    interior = best._with_attempts(attempts)
     if interior.inverted and len(plan) > 1:
         raise GeometryError(_inverted_message(interior))
     return interior

@@ -133,7 +133,7 @@ def quality(field, c1, c2, *, closed=True):
             v1, f1 = as_surface(c1, "s1", core_checks=True)
             v2, f2 = as_surface(c2, "s2", core_checks=True)
             found = _core.surface_quality(field.starts, field.ends, faces, v1, f1, v2, f2)
-        return SurfaceQuality(float(found["qm1"]), float(found["qm2"]), float(found["qm"]), int(found["folds"]))
+        return SurfaceQuality(**found)
     if field.dim != 2:
         raise ValueError(f"field: expected a 2D displacement field, got {field.dim}D")
     if isinstance(c1, PreparedCurve) and isinstance(c2, PreparedCurve):
@@ -144,4 +144,4 @@ def quality(field, c1, c2, *, closed=True):
         c2 = as_curve(c2, "c2")
         closed = as_flag(closed, "closed")
         found = _core.curve_quality(field.starts, field.ends, c1, c2, closed)
-    return CurveQuality(float(found["qm1"]), float(found["qm2"]), float(found["qm"]), int(found["crossings"]))
+    return CurveQuality(**found)

@@ -80,4 +80,4 @@ def align_curves(c1, c2, *, closed=True, tolerance=1e-6) -> Similarity:
         raise TypeError(f"tolerance: expected a real number, got {type(tolerance).__name__}")
     # The value rule (positive and finite) is the C++ core's.
     found = _core.align_curves(as_points(c1, "c1"), as_points(c2, "c2"), closed, float(tolerance))
-    return Similarity(found["centre"], found["scale"], found["angle"], found["translation"])
+    return Similarity(**found)
