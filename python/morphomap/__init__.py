@@ -5,9 +5,10 @@ with the algorithms of Schwaninger, Menshykau and Iber (minimal distance, normal
 uniform) and their extensions and quality measures.
 """
 
+from . import best  # noqa: F401  (registers method "best" with map_curves and map_surfaces)
 from ._core import GeometryError, InvalidInput
 from ._core import build_info as _build_info
-from .components import split_components
+from ._lazy import lazy_names
 from .crossings import count_crossings, crossing_pairs
 from .curves import (
     arc_lengths,
@@ -23,28 +24,26 @@ from .diffusion import DiffusionSolution, solve_diffusion
 from .diffusion3d import ShellDiffusionSolution, solve_diffusion_3d
 from .extend import InteriorField, extend_field
 from .field import DisplacementField
-from .images import Image, boundary_from_mask, read_image, surface_from_mask
-from .io import (
-    load_example,
-    read_curve,
-    read_field,
-    read_surface,
-    write_curve,
-    write_field,
-    write_interior,
-    write_surface,
-)
 from .mapping import map_curves
-from .plot import plot_field, plot_field_3d
-from .quality import CurveQuality, SurfaceQuality, quality
-from .batch import Job, map_batch
-from . import best  # noqa: F401  (registers method "best" with map_curves and map_surfaces)
-from .series import Series, map_series
-from .simple import make_simple
-from .queries import CurveHits, CurveIndex, closest_points, line_intersections
 from .prepared import PreparedCurve, PreparedSurface
-from .surfaces import SurfaceHits, SurfaceIndex, map_surfaces, remesh_surface, surface_normals
+from .quality import CurveQuality, SurfaceQuality, quality
+from .queries import CurveHits, CurveIndex, closest_points, line_intersections
+from .simple import make_simple
+from .surfaces import SurfaceHits, SurfaceIndex, map_surfaces, surface_normals
 from .transform import Similarity, align_curves, overlap_area
+
+# Imported on first use: these modules import trimesh, matplotlib, scipy.ndimage, meshio, h5py or
+# distributed at their tops (about 1.5 s together), which the mapping core above does without.
+__getattr__, __dir__ = lazy_names(__name__, globals(), {
+    "batch": ("Job", "map_batch"),
+    "components": ("split_components",),
+    "images": ("Image", "boundary_from_mask", "read_image", "surface_from_mask"),
+    "io": ("load_example", "read_curve", "read_field", "read_surface", "write_curve", "write_field",
+           "write_interior", "write_surface"),
+    "plot": ("plot_field", "plot_field_3d"),
+    "remesh": ("remesh_surface",),
+    "series": ("Series", "map_series"),
+})
 
 __version__ = _build_info()["version"]
 

@@ -2,7 +2,7 @@
 
 ``progress=None`` shows a tqdm bar on stderr once a call has run for 3 seconds, and only when
 stderr is a terminal; ``True`` shows it at once, anywhere; ``False`` never. Progress is a
-courtesy: it never changes a result, and nothing is shown without tqdm.
+courtesy: it never changes a result.
 """
 
 from __future__ import annotations
@@ -10,6 +10,7 @@ from __future__ import annotations
 import sys
 
 import numpy as np
+from tqdm import tqdm
 
 DELAY = 3.0  # seconds before a bar appears with progress=None
 
@@ -23,10 +24,6 @@ def as_progress(value) -> bool | None:
 def _tqdm(progress, **options):
     """A tqdm bar, or None where the rule says no bar."""
     if progress is False or (progress is None and not sys.stderr.isatty()):
-        return None
-    try:
-        from tqdm import tqdm
-    except ImportError:
         return None
     return tqdm(delay=0 if progress else DELAY, **options)
 

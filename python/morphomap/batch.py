@@ -10,7 +10,17 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 
+import dask
+import numpy as np
+from distributed import Client, LocalCluster, WorkerPlugin, as_completed
+
+from . import _core
 from ._progress import as_progress, progress_over
+from .io import write_field
+from .io.frames import read_boundary
+from .mapping import map_curves
+from .quality import quality
+from .surfaces import map_surfaces
 
 
 @dataclass
@@ -35,21 +45,30 @@ class JobResult:
 
 def run_job(job: Job) -> str:
     """Map one job in this process; returns a one-line summary. Raises on failure."""
-    import numpy as np
-
-    import morphomap as mm
-
-    from .io.frames import read_boundary
-
     (b1, _), (b2, _) = (read_boundary(p, spacing=job.spacing, smooth=job.smooth) for p in (job.c1, job.c2))
     if isinstance(b1, np.ndarray):
-        field = mm.map_curves(b1, b2, job.method)
+        field = map_curves(b1, b2, job.method)
     else:
-        field = mm.map_surfaces(b1, b2, job.method)
-    q = mm.quality(field, b1, b2)
-    mm.write_field(job.output, field)
+        field = map_surfaces(b1, b2, job.method)
+    q = quality(field, b1, b2)
+    write_field(job.output, field)
     defects = f"crossings {q.crossings}" if field.dim == 2 else f"folds {q.folds}"
     return f"{len(field)} vectors, {int((~field.valid).sum())} missed, QM {q.qm:.4g}, {defects}"
+
+
+class ShareCores(WorkerPlugin):
+    """Each worker of a local cluster runs the core's threads (TBB, and Embree on it) on its share
+    of the cores: with as many single-threaded workers as cores, every worker's TBB would start a
+    thread per core, and the workers' threads would fight over the cores. The worker unpickles the
+    plugin while it starts, which imports this module and the core before its first job."""
+
+    name = "morphomap-share-cores"
+
+    def __init__(self, threads: int):
+        self.threads = threads
+
+    def setup(self, worker):
+        _core.limit_threads(self.threads)
 
 
 def map_batch(jobs, client=None, *, workers=None, progress=None, task=None) -> list:
@@ -65,9 +84,6 @@ def map_batch(jobs, client=None, *, workers=None, progress=None, task=None) -> l
     ``progress``: a bar counting the jobs, by default on a terminal once the batch has run for 3
     seconds (``True``: at once, ``False``: never).
     """
-    import dask
-    from distributed import Client, LocalCluster, as_completed
-
     jobs = list(jobs)
     progress = as_progress(progress)
     results = {}
@@ -89,8 +105,6 @@ def map_batch(jobs, client=None, *, workers=None, progress=None, task=None) -> l
         settings["distributed.worker.profile.enabled"] = False
     with dask.config.set(settings):
         if own:
-            from ._batch_worker import ShareCores
-
             count = workers or min(len(pending), os.cpu_count() or 1)
             cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, dashboard_address=None,
                                    plugins={ShareCores(max(1, (os.cpu_count() or 1) // count))})

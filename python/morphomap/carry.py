@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .queries import CurveIndex
+
 
 def _knots(curve: np.ndarray, closed: bool) -> tuple[np.ndarray, np.ndarray]:
     """The curve's vertices (closed: the first repeated at the end) and their arc lengths."""
@@ -36,8 +38,6 @@ class IndexedCurve:
     """
 
     def __init__(self, points, closed: bool):
-        from .queries import CurveIndex
-
         self.points, self.closed = np.asarray(points, dtype=float), closed
         self.index = CurveIndex(self.points, closed=closed)
         self.length = float(_knots(self.points, closed)[1][-1])

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import numpy as np
+import trimesh
 
 from ._validate import as_points
 from .curves import signed_area
@@ -67,8 +68,6 @@ def split_components(value, *, gap=None):
         if gap is not None and (not np.isfinite(gap) or gap <= 0):
             raise ValueError(f"gap: must be a finite length > 0, got {gap}")
         return sorted(_loops(points, gap), key=lambda loop: abs(signed_area(loop)), reverse=True)
-    import trimesh
-
     vertices, faces = as_surface(value, "value")
     parts = trimesh.Trimesh(vertices, faces, process=False).split(only_watertight=False)
     parts = sorted(parts, key=lambda part: part.area, reverse=True)

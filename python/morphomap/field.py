@@ -157,8 +157,6 @@ class DisplacementField:
 
         Returns ``(P, d)`` float (and ``(P,)`` distances).
         """
-        from . import _core
-
         points = as_points(points, "points", self.dim)
         if self.dim == 3:
             if self._faces is None:

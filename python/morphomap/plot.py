@@ -5,12 +5,17 @@ from __future__ import annotations
 import os
 import sys
 
+import matplotlib
 import numpy as np
+from matplotlib.collections import LineCollection
+from matplotlib.figure import Figure
+from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
-from .io.atomic import atomic_path
 from ._validate import as_flag, as_points
 from .crossings import crossing_pairs
 from .field import DisplacementField
+from .io.atomic import atomic_path
+from .prepared import as_surface
 
 C1_COLOUR = "tab:green"
 C2_COLOUR = "tab:blue"
@@ -29,10 +34,9 @@ def _headless() -> bool:
 
 
 def _new_axes(projection=None):
-    import matplotlib
-
     if _headless():
         matplotlib.use("Agg")
+    # pyplot only after the backend is chosen, and only where a figure is wanted on screen.
     import matplotlib.pyplot as plt
 
     figure = plt.figure(figsize=(6, 6))
@@ -85,8 +89,6 @@ def plot_field(field, c1, c2, ax=None, *, closed=True, title=None, y_down=False)
     closed = as_flag(closed, "closed")
     if title is not None and not isinstance(title, str):
         raise TypeError(f"title: expected a string, got {type(title).__name__}")
-    from matplotlib.collections import LineCollection
-
     if ax is None:
         ax = _new_axes()
 
@@ -135,10 +137,6 @@ def plot_field_3d(field, s1, s2, ax=None, *, title=None):
     ``s1``, ``s2``: ``trimesh.Trimesh`` or ``(vertices, faces)`` pairs; ``ax``: a 3D axes
     (``projection="3d"``), by default a new figure.
     """
-    from mpl_toolkits.mplot3d.art3d import Line3DCollection
-
-    from .surfaces import as_surface
-
     if not isinstance(field, DisplacementField):
         raise TypeError(f"field: expected a DisplacementField, got {type(field).__name__}")
     if field.dim != 3:
@@ -182,6 +180,12 @@ def plot_field_3d(field, s1, s2, ax=None, *, title=None):
     if title is not None:
         ax.set_title(title)
     return ax
+
+
+def offscreen_figure(width: float, height: float) -> Figure:
+    """A figure of ``width`` x ``height`` inches with constrained layout, without pyplot: nothing
+    is shown, and it is freed with its last reference (for pictures written to files)."""
+    return Figure(figsize=(width, height), layout="constrained")
 
 
 def save_figure(figure, path, **options) -> None:

@@ -10,6 +10,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from .curves import perimeter
+from .queries import CurveIndex
+from .surfaces import SurfaceIndex
+
 #: At most this many rounds of edge splits per frame in 3D (each round at least halves the longest
 #: edges, so this is only a guard against a surface that cannot be sampled).
 MAX_SPLIT_ROUNDS = 64
@@ -31,9 +35,6 @@ def reseed_curve(points, chain, growth, frame, spacing, limit, closed):
     Returns ``(new_points (B, 2), chain, growth)``: the new points get the ids ``M``, ``M + 1``, ...
     in that order and sit in ``chain`` between the two points whose piece they split.
     """
-    from .curves import perimeter
-    from .queries import CurveIndex
-
     pieces = len(chain) if closed else len(chain) - 1
     if pieces < 1:
         return np.empty((0, 2)), chain, growth
@@ -95,8 +96,6 @@ def reseed_surface(points, faces, growth, frame, limit):
 
     Returns ``(new_points (B, 3), faces, growth)``, the new points numbered from ``M`` on.
     """
-    from .surfaces import SurfaceIndex
-
     index = None
     points = np.asarray(points, dtype=float)
     grown = []

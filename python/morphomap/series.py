@@ -5,11 +5,26 @@ from __future__ import annotations
 import functools
 import os
 import time
+import warnings
 from dataclasses import dataclass, field as dataclass_field
 
 import numpy as np
+import trimesh
 
+from ._core import GeometryError
 from ._progress import progress_over
+from ._validate import as_length
+from .carry import IndexedCurve, carry_curve, carry_surface
+from .curves import normals
+from .io import write_field
+from .io.atomic import atomic_text
+from .mapping import map_curves
+from .prepared import PreparedCurve, PreparedSurface, as_surface
+from .quality import quality
+from .reseed import reseed_curve, reseed_surface
+from .series_plot import animate, plot_growth, plot_trajectories, write_figures
+from .simple import make_simple
+from .surfaces import SurfaceIndex, map_surfaces, surface_normals
 
 
 @dataclass
@@ -98,21 +113,15 @@ class Series:
 
     def plot_trajectories(self, ax=None, **options):
         """The followed points' paths coloured by time: :func:`morphomap.series_plot.plot_trajectories`."""
-        from .series_plot import plot_trajectories
-
         return plot_trajectories(self, ax, **options)
 
     def plot_growth(self, quantity="accumulated_stretch", step=-1, ax=None, **options):
         """A growth map as colour on the boundary: :func:`morphomap.series_plot.plot_growth`."""
-        from .series_plot import plot_growth
-
         return plot_growth(self, quantity, step, ax, **options)
 
     def animate(self, path, *, fps=2, dpi=90) -> None:
         """Write an animation (``.gif``; ``.mp4`` when ffmpeg is installed) of the frames and the
         followed points: :func:`morphomap.series_plot.animate`."""
-        from .series_plot import animate
-
         animate(self, path, fps=fps, dpi=dpi)
 
     def write(self, folder, *, figures=True) -> list:
@@ -131,9 +140,6 @@ class Series:
 
         Writes are atomic.
         """
-        from .io.atomic import atomic_text
-        from .io import write_field
-
         os.makedirs(folder, exist_ok=True)
         paths = []
         for k, field in enumerate(self.fields):
@@ -180,32 +186,7 @@ class Series:
                     handle.write(f"{k},{i},{v!r},{m!r}\n")
         paths.append(path)
         if figures:
-            paths.extend(self._write_figures(folder))
-        return paths
-
-    def _write_figures(self, folder) -> list:
-        import matplotlib.animation as animation
-        from matplotlib.backends.backend_agg import FigureCanvasAgg
-        from matplotlib.figure import Figure
-
-        from .plot import save_figure
-
-        paths = []
-        for name, draw in (("trajectories", lambda ax: self.plot_trajectories(ax)),
-                           ("stretch", lambda ax: self.plot_growth("accumulated_stretch", -1, ax)),
-                           ("normal_speed", lambda ax: self.plot_growth("accumulated_normal_speed", -1, ax))):
-            figure = Figure(figsize=(7, 6), layout="constrained")
-            FigureCanvasAgg(figure)
-            draw(figure.add_subplot(projection="3d" if self.dim == 3 else None))
-            path = os.path.join(folder, f"{name}.png")
-            save_figure(figure, path, dpi=100)
-            paths.append(path)
-        for suffix in ("gif", "mp4"):
-            if suffix == "mp4" and not animation.writers.is_available("ffmpeg"):
-                continue
-            path = os.path.join(folder, f"series.{suffix}")
-            self.animate(path)
-            paths.append(path)
+            paths.extend(write_figures(self, folder))
         return paths
 
     def __repr__(self) -> str:
@@ -261,15 +242,6 @@ def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **op
     ValueError, GeometryError
         A frame or pair that cannot be mapped, named: ``"frames[k] -> frames[k + 1]: ..."``
     """
-    from ._core import GeometryError
-    from ._validate import as_length
-    from .carry import IndexedCurve, carry_curve, carry_surface
-    from .mapping import map_curves
-    from .prepared import PreparedCurve
-    from .quality import quality
-    from .prepared import PreparedSurface, as_surface
-    from .surfaces import SurfaceIndex, map_surfaces
-
     frames = list(frames)
     if len(frames) < 2:
         raise ValueError(f"frames: expected at least 2, got {len(frames)}")
@@ -282,8 +254,6 @@ def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **op
         if reseed <= 1:
             raise ValueError(f"reseed: the factor must be > 1 (or None to switch re-seeding off), got {reseed}")
     if not curves[0]:
-        import trimesh
-
         frames = [trimesh.Trimesh(*as_surface(f, f"frames[{k}]"), process=False) for k, f in enumerate(frames)]
     closed = bool(options.get("closed", True)) if curves[0] else True
     if curves[0]:
@@ -361,10 +331,6 @@ def _simple_frames(frames, closed: bool) -> list:
     """The curves made simple once each (:func:`morphomap.make_simple`), warning per frame repaired.
     A curve it refuses (one that crosses itself, non-finite points) is kept as given: its pair's
     mapping reports it, named with the pair."""
-    import warnings
-
-    from .simple import make_simple
-
     simple = []
     for k, frame in enumerate(frames):
         try:
@@ -403,8 +369,6 @@ class _CurveBoundary:
         return np.append(cells[:, 0], cells[-1, 1])
 
     def normals(self, cells, points):
-        from .curves import normals
-
         chain = self.chain(cells)
         result = np.full_like(points, np.nan)
         if len(chain) >= (3 if self.closed else 2):
@@ -424,8 +388,6 @@ class _CurveBoundary:
         return chain[keep], np.where(intact, growth[positions[: len(following)]], np.nan)
 
     def reseed(self, points, chain, growth, frame, factor):
-        from .reseed import reseed_curve
-
         return reseed_curve(points, chain, growth, np.asarray(self.frames[frame], dtype=float), self.spacing,
                             factor * self.spacing, self.closed)
 
@@ -450,8 +412,6 @@ class _SurfaceBoundary:
         return 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
 
     def normals(self, cells, points):
-        from .surfaces import surface_normals
-
         return surface_normals(np.nan_to_num(points), cells)
 
     def without_lost(self, cells, growth, alive):
@@ -461,8 +421,6 @@ class _SurfaceBoundary:
         return cells[keep], growth[keep]
 
     def reseed(self, points, faces, growth, frame, factor):
-        from .reseed import reseed_surface
-
         surface = self.frames[frame]
         return reseed_surface(points, faces, growth, (np.asarray(surface.vertices), np.asarray(surface.faces)),
                               factor * self.spacing)

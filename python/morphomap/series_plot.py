@@ -2,10 +2,18 @@
 
 from __future__ import annotations
 
+import os
+
+import matplotlib.animation as animation
 import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.collections import LineCollection
+from matplotlib.colors import Normalize, TwoSlopeNorm
+from matplotlib.figure import Figure
+from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
 from .io.atomic import atomic_path
-from .plot import C1_COLOUR, _new_axes
+from .plot import C1_COLOUR, _new_axes, offscreen_figure, save_figure
 
 #: At most this many trajectories are drawn in 3D (evenly chosen): more only hide the surfaces.
 MAX_TRAJECTORIES_3D = 1500
@@ -63,9 +71,6 @@ def _limits(ax, series, frames):
 def _trajectory_lines(ax, series, last, norm):
     """The trajectories from frame 0 to frame ``last`` as one collection, each step's piece
     coloured by the frame it ends on."""
-    from matplotlib.collections import LineCollection
-    from mpl_toolkits.mplot3d.art3d import Line3DCollection
-
     points = np.arange(series.trajectories.shape[1])
     if series.dim == 3 and len(points) > MAX_TRAJECTORIES_3D:
         points = points[np.linspace(0, len(points) - 1, MAX_TRAJECTORIES_3D).astype(int)]
@@ -91,8 +96,6 @@ def plot_trajectories(series, ax=None, *, title=None):
     (a colour bar gives the frame); in 3D at most :data:`MAX_TRAJECTORIES_3D` paths, evenly chosen.
     ``ax``: where to draw (a 3D axes for a 3D series), by default a new figure.
     """
-    from matplotlib.colors import Normalize
-
     ax = _check_axes(ax, series.dim)
     last = len(series.frames) - 1
     for t in range(len(series.frames)) if series.dim == 2 else (0, last):
@@ -128,10 +131,6 @@ def plot_growth(series, quantity="accumulated_stretch", step=-1, ax=None, *, tit
     one centred on 0 for normal speeds that change sign. Pieces with an unknown value
     (a lost point) are left out. A colour bar gives the scale.
     """
-    from matplotlib.collections import LineCollection
-    from matplotlib.colors import Normalize, TwoSlopeNorm
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-
     values, cells, points = growth_map(series, quantity, step)
     ax = _check_axes(ax, series.dim)
     shown = np.isfinite(values) & np.isfinite(points[cells]).all(axis=(1, 2))
@@ -164,11 +163,6 @@ def animate(series, path, *, fps=2, dpi=90):
     One picture per frame: that frame's boundary, the paths of the followed points so far coloured
     by time and the points where they are. Fixed limits over all frames. Written atomically.
     """
-    import matplotlib.animation as animation
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.colors import Normalize
-    from matplotlib.figure import Figure
-
     name = str(path)
     suffix = name.lower().rsplit(".", 1)[-1] if "." in name else ""
     if suffix == "gif":
@@ -197,3 +191,25 @@ def animate(series, path, *, fps=2, dpi=90):
                 _limits(ax, series, range(len(series.frames)))
                 ax.set_title(f"frame {t} of {last}: {len(now)} points")
                 writer.grab_frame()
+
+
+def write_figures(series, folder) -> list:
+    """The figures of :meth:`Series.write` into ``folder``: the trajectories, the accumulated growth
+    maps at the last frame and the animation (GIF; MP4 when ffmpeg is there). Returns the paths."""
+    paths = []
+    for name, draw in (("trajectories", lambda ax: series.plot_trajectories(ax)),
+                       ("stretch", lambda ax: series.plot_growth("accumulated_stretch", -1, ax)),
+                       ("normal_speed", lambda ax: series.plot_growth("accumulated_normal_speed", -1, ax))):
+        figure = offscreen_figure(7, 6)
+        FigureCanvasAgg(figure)
+        draw(figure.add_subplot(projection="3d" if series.dim == 3 else None))
+        path = os.path.join(folder, f"{name}.png")
+        save_figure(figure, path, dpi=100)
+        paths.append(path)
+    for suffix in ("gif", "mp4"):
+        if suffix == "mp4" and not animation.writers.is_available("ffmpeg"):
+            continue
+        path = os.path.join(folder, f"series.{suffix}")
+        series.animate(path)
+        paths.append(path)
+    return paths

@@ -8,7 +8,7 @@ import numpy as np
 
 from . import _core
 from ._progress import StageBar, as_progress
-from ._validate import as_choice, as_faces, as_flag, as_integer, as_points, as_real
+from ._validate import as_choice, as_faces, as_flag, as_points, as_real
 from .chooser import BEST, CHOOSERS
 from .field import DisplacementField
 from .prepared import PreparedSurface, as_surface
@@ -79,38 +79,6 @@ def surface_normals(vertices, faces) -> np.ndarray:
     """
     vertices = as_points(vertices, "vertices", 3)
     return _core.vertex_normals(vertices, as_faces(faces, "faces", len(vertices)))
-
-
-def remesh_surface(surface, edge_length, *, iterations=3):
-    """The same closed surface with near-uniform triangles of edge length about ``edge_length``.
-
-    CGAL's isotropic remeshing in the C++ core (edge splits, collapses, flips and tangential
-    relaxation, every new vertex projected back onto the input), as :func:`surface_from_mask`
-    uses; for coarse surfaces with long thin triangles, such as an open surface closed by a flat
-    cap. ``map_surfaces`` refines such input itself for diffusion (see its ``method``); remesh
-    first to have the field on the even vertices.
-
-    Parameters
-    ----------
-    surface : trimesh.Trimesh or (vertices (V, 3) float, faces (F, 3) int)
-        Closed, manifold, one piece; zero-area faces are removed first. The orientation is kept.
-    edge_length : float
-        Target edge length, in the surface's units (> 0).
-    iterations : int
-        Remeshing rounds (>= 1); three bring the smallest angles above 20 degrees on contoured masks.
-
-    Returns
-    -------
-    trimesh.Trimesh
-    """
-    import trimesh
-
-    vertices, faces = as_surface(surface, "surface")
-    if edge_length is None:
-        raise TypeError("edge_length: expected a positive number, got None")
-    remeshed = _core.remesh_surface(vertices, faces, as_real(edge_length, "edge_length", 0.0),
-                                    as_integer(iterations, "iterations", 3))
-    return trimesh.Trimesh(remeshed["vertices"], remeshed["faces"], process=False)
 
 
 def map_surfaces(s1, s2, method="auto", *, reverse=False, mesh_size=None, repeatable=True,

@@ -97,6 +97,8 @@ def solve(folder, diffusivity: float = 0.01, substeps: int = 10, centre=(1.0, 0.
 def plot(result, path):
     """The concentration on the last frame, on the moved mesh (3D: the tetrahedra's corners
     within a thin slab about z = 0)."""
+    # This file runs in the Python that has dolfinx, by its path, where matplotlib is an extra;
+    # the backend is chosen before pyplot is imported.
     import matplotlib
 
     matplotlib.use("Agg")
@@ -127,6 +129,7 @@ def main(argv=None):
     argv = sys.argv[1:] if argv is None else argv
     folder = argv[0] if argv else "growing-frames"
     if not os.path.exists(os.path.join(folder, "motion.xdmf")):
+        # Only where one Python has both: dolfinx's own Python need not have morphomap.
         from morphomap.examples.growing_frames import prepare
 
         prepare(folder)

@@ -18,6 +18,10 @@ import os
 import sys
 
 import numpy as np
+import trimesh
+
+import morphomap as mm
+from morphomap.io import write_interior_series
 
 
 def frames(count: int = 5, points: int = 400):
@@ -32,8 +36,6 @@ def frames(count: int = 5, points: int = 400):
 def surfaces(count: int = 5, subdivisions: int = 3):
     """``count`` closed surfaces ``(vertices (V, 3), faces (F, 3))``, the 3D form of
     :func:`frames`: a sphere that widens while a bud grows out of it."""
-    import trimesh
-
     sphere = trimesh.creation.icosphere(subdivisions)
     directions = sphere.vertices / np.linalg.norm(sphere.vertices, axis=1)[:, None]
     angle = np.arccos(np.clip(directions @ np.array([np.cos(0.5), np.sin(0.5), 0.0]), -1.0, 1.0))
@@ -50,9 +52,6 @@ def prepare(folder, count: int = 5, mesh_size: float = None, dt: float = 1.0, di
     list of InteriorField
         Step k: frame k's nodes (``points``) and their displacement to frame k + 1.
     """
-    import morphomap as mm
-    from morphomap.io import write_interior_series
-
     if dim not in (2, 3):
         raise ValueError(f"dim: expected 2 or 3, got {dim!r}")
     shapes, mapping = (frames(count), mm.map_curves) if dim == 2 else (surfaces(count), mm.map_surfaces)

@@ -18,16 +18,16 @@ zero row sums. scikit-fem assembles the matrices.
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse.linalg as sparse
+
+import morphomap as mm
 
 
 def run(steps: int = 20, diffusivity: float = 0.01, mesh_size: float = 0.05):
     """Solve the growing-domain problem; returns a dict with the masses, the nodes and cells,
     the final concentration and the smallest cell area seen (negative: an inverted cell)."""
-    import scipy.sparse.linalg as sparse
     from skfem import Basis, BilinearForm, ElementTriP1, MeshTri
     from skfem.helpers import dot, grad
-
-    import morphomap as mm
 
     c1, c2 = mm.load_example("kidney")
     field = mm.map_curves(c1, c2, "diffusion")

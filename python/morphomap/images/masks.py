@@ -10,7 +10,11 @@ from __future__ import annotations
 import numbers
 
 import numpy as np
+import trimesh
+from scipy import ndimage
+from skimage import measure
 
+from .. import _core
 from .._validate import as_length
 from ..curves import signed_area
 
@@ -51,8 +55,6 @@ def _object(mask, label, name: str, ndim: int = 2) -> np.ndarray:
 
 
 def _require_one_object(pixels: np.ndarray, name: str) -> None:
-    from scipy import ndimage
-
     # Face connectivity (4 in 2D, 6 in 3D): marching squares and cubes at level 0.5 separate
     # pixels that touch only at a corner or an edge.
     components, count = ndimage.label(pixels)
@@ -79,8 +81,6 @@ def _outer_contour(image: np.ndarray):
     """``(outer, pieces)``: the level 0.5 of ``image`` with the largest area, as (row, column)
     points with the end repeated, and the number of contours outside it (pieces the object fell
     into besides the outer one; holes do not count). None when no contour is left."""
-    from skimage import measure
-
     contours = [c for c in measure.find_contours(image, 0.5) if len(c) >= 4]
     if not contours:
         return None
@@ -90,8 +90,6 @@ def _outer_contour(image: np.ndarray):
 
 
 def _smoothed(image: np.ndarray, sigma_pixels) -> np.ndarray:
-    from scipy import ndimage
-
     if max(sigma_pixels) <= 0:
         return image
     # The Gaussian reads zeros beyond the array (mode "constant"), as if padded by its reach, and
@@ -103,8 +101,6 @@ def _smoothed(image: np.ndarray, sigma_pixels) -> np.ndarray:
 def _default_contour(image: np.ndarray):
     """The outer contour at the default smoothing (see :func:`boundary_from_mask`), halving the
     width while the object vanishes, splits or loses a part, down to none."""
-    from scipy import ndimage
-
     pixels = image > 0.5
     thickness = ndimage.distance_transform_edt(pixels).max()
     width = min(DEFAULT_SMOOTH_PIXELS, DEFAULT_SMOOTH_PIXELS * thickness / DEFAULT_SMOOTH_THICKNESS)
@@ -262,12 +258,6 @@ def surface_from_mask(volume, spacing=(1.0, 1.0, 1.0), *, label=None, smooth=0.0
         (``edge_length=1``) an unsmoothed surface follows the staircase (area 11% too large);
         ``smooth=1`` brings it back within 0.2%.
     """
-    import trimesh
-    from scipy import ndimage
-    from skimage import measure
-
-    from .. import _core
-
     voxels = _object(volume, label, "volume", ndim=3)
     step = _spacing(spacing, 3)
     sigma = as_length(smooth, "smooth", 0.0, allow_zero=True)

@@ -8,9 +8,11 @@ voxel size come in as Fiji shows them.
 from __future__ import annotations
 
 import os
+import xml.etree.ElementTree as ElementTree
 from typing import NamedTuple, Optional
 
 import numpy as np
+import tifffile
 
 
 class Image(NamedTuple):
@@ -27,9 +29,7 @@ def _tiff_spacing(tif, stack: bool):
     resolution tags (pixels per ImageJ's unit, or per inch / centimetre, then in microns) with
     ImageJ's z ``spacing``; None where the file states no size."""
     if tif.is_ome and tif.ome_metadata:
-        import xml.etree.ElementTree as ET
-
-        pixels = next((e for e in ET.fromstring(tif.ome_metadata).iter() if e.tag.endswith("Pixels")), None)
+        pixels = next((e for e in ElementTree.fromstring(tif.ome_metadata).iter() if e.tag.endswith("Pixels")), None)
         if pixels is not None and "PhysicalSizeX" in pixels.attrib:
             sx = float(pixels.attrib["PhysicalSizeX"])
             sy = float(pixels.attrib.get("PhysicalSizeY", sx))
@@ -77,14 +77,12 @@ def read_image(path) -> Image:
     if suffix == ".npy":
         return Image(np.load(name, allow_pickle=False), None)
     if suffix in (".tif", ".tiff"):
-        import tifffile
-
         with tifffile.TiffFile(name) as tif:
             data = tif.asarray()
             spacing = _tiff_spacing(tif, stack=data.ndim >= 3 and len(tif.series[0].pages) > 1)
         return Image(data, spacing)
     if suffix == ".png":
-        from PIL import Image as PILImage
+        from PIL import Image as PILImage  # Pillow: not a declared dependency (matplotlib brings it)
 
         with PILImage.open(name) as picture:
             data = np.asarray(picture)

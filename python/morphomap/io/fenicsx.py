@@ -22,6 +22,7 @@ from __future__ import annotations
 import os
 import xml.etree.ElementTree as ElementTree
 
+import h5py
 import numpy as np
 
 
@@ -53,8 +54,6 @@ def read_times(path) -> list:
 def read_point_data(path, name="displacement", *, time=None):
     """Point data ``name`` of a morphomap XDMF file as numpy: ``(P, 3)`` vectors or ``(P,)``, in the
     file's node order (without dolfinx). ``time``: a step of a series (default: the grid ``mesh``)."""
-    import h5py
-
     path = os.fspath(path)
     grid = _grid(ElementTree.parse(path).getroot(), path, time)
     attribute = grid.find(f"Attribute[@Name='{name}']")

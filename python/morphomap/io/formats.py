@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import os
 
+from ..extend import InteriorField
+from ..field import DisplacementField
 from . import solver
 from .csv_files import write_field_csv
 
@@ -97,8 +99,6 @@ def write_field(path, field, *, dt=None) -> None:
     dt : float, optional
         The time between the two boundaries: adds the velocity ``vectors / dt`` (not to CSV).
     """
-    from ..field import DisplacementField
-
     if not isinstance(field, DisplacementField):
         raise TypeError(f"field: expected a DisplacementField, got {type(field).__name__}")
     if hasattr(path, "write"):
@@ -111,8 +111,6 @@ def write_interior(path, interior, dt=None) -> None:
     """Write an :class:`~morphomap.extend.InteriorField`: ``.xdmf`` (grid ``mesh``, for dolfinx's
     ``read_mesh()``), ``.vtu`` (the mesh and ``displacement``, with ``velocity`` when ``dt`` is
     given) or a COMSOL ``.txt`` table (node, displacement[, velocity])."""
-    from ..extend import InteriorField
-
     if not isinstance(interior, InteriorField):
         raise TypeError(f"interior: expected an InteriorField, got {type(interior).__name__}")
     writer(path, "interior")(path, interior, dt)
@@ -130,8 +128,6 @@ def write_interior_series(path, interiors, times) -> None:
     times : sequence of float
         One per step, increasing.
     """
-    from ..extend import InteriorField
-
     interiors = list(interiors)
     times = [float(t) for t in times]
     if not interiors or not all(isinstance(i, InteriorField) for i in interiors):

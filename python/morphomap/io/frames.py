@@ -4,6 +4,10 @@ from __future__ import annotations
 
 import os
 
+from ..images import boundary_from_mask, read_image, surface_from_mask
+from .csv_files import read_curve
+from .meshes import SURFACE_SUFFIXES, read_surface
+
 IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".npy")
 
 
@@ -16,10 +20,6 @@ def read_boundary(path, *, spacing=None, label=None, smooth=None, edge_length=No
     each one's default (a sub-pixel outline of a 2D mask, a 3D stack unsmoothed).
     ``report``, given, is called with one line saying which spacing was used.
     """
-    from ..images import boundary_from_mask, read_image, surface_from_mask
-    from .csv_files import read_curve
-    from .meshes import SURFACE_SUFFIXES, read_surface
-
     name = os.fspath(path)
     if name.lower().endswith(SURFACE_SUFFIXES):
         return read_surface(name), False

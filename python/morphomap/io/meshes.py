@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import os
 
+import meshio
 import numpy as np
+import trimesh
 
 from .. import _core
 from ..prepared import as_surface
@@ -44,8 +46,6 @@ def read_surface(path):
 
     Returns a ``trimesh.Trimesh``.
     """
-    import trimesh
-
     _suffix(path, "path")
     if not os.path.isfile(path):
         raise ValueError(f"path: no such file: {os.fspath(path)}")
@@ -67,16 +67,12 @@ def write_surface(path, mesh) -> None:
     STL, PLY, OBJ or OFF file, chosen by the suffix: PLY binary with double coordinates (exact),
     OBJ and OFF as text with 15 decimals, STL binary in float32 as the format defines it. The
     write is atomic: a failed or interrupted write leaves the previous file as it was."""
-    import trimesh
-
     suffix = _suffix(path, "path")
     vertices, faces = as_surface(mesh, "mesh")
     surface = trimesh.Trimesh(np.asarray(vertices), np.asarray(faces), process=False)
     with atomic_path(path) as temporary:
         if suffix == ".ply":
             # trimesh writes PLY coordinates as float32; meshio keeps doubles.
-            import meshio
-
             mesh = meshio.Mesh(surface.vertices, [("triangle", surface.faces.astype(np.int32))])
             meshio.write(temporary, mesh, file_format="ply", binary=True)
         else:

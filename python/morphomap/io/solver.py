@@ -38,10 +38,12 @@ import shutil
 import tempfile
 from xml.sax.saxutils import quoteattr
 
+import meshio
 import numpy as np
 
 from .._validate import as_length
 from ..field import METHOD_NAMES
+from .atomic import atomic_text
 from .xdmf import Frame, write_xdmf
 
 CELL_TYPES = {2: "triangle", 3: "tetra"}
@@ -113,8 +115,6 @@ def _with_methods(content):
 
 
 def _vtu(temporary, content):
-    import meshio
-
     point_data, field_data = _with_methods(content)
     mesh = meshio.Mesh(pad3(content.points), [(content.cell_type, content.cells)], point_data=point_data,
                        field_data=field_data)
@@ -203,8 +203,6 @@ def write_poly_data(path, content) -> None:
 def write_comsol(path, content) -> None:
     """A COMSOL interpolation table: node, displacement[, velocity] per row. Only the rows whose
     vector is valid (an interpolation table has no gaps)."""
-    from .atomic import atomic_text
-
     dim = content.points.shape[1]
     data = content.point_data
     keep = data["valid"].astype(bool) if "valid" in data else np.ones(len(content.points), dtype=bool)

@@ -17,6 +17,7 @@ from __future__ import annotations
 import os
 import xml.etree.ElementTree as ElementTree
 
+import h5py
 import numpy as np
 
 TOPOLOGY = {"vertex": "Polyvertex", "triangle": "Triangle", "tetra": "Tetrahedron"}
@@ -96,8 +97,6 @@ def write_xdmf(path, frames, times=None) -> None:
     Frames of a series share their cells (one mesh moving); the first frame is the grid ``mesh``.
     Not atomic by itself: the callers write into a scratch folder and rename.
     """
-    import h5py
-
     path = os.fspath(path)
     h5_name = os.path.splitext(os.path.basename(path))[0] + ".h5"
     root = ElementTree.Element("Xdmf", Version="3.0")

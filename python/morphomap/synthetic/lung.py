@@ -21,6 +21,8 @@ of the saddles between the trunk and the daughters, cross before they reach S2.
 from __future__ import annotations
 
 import numpy as np
+import trimesh
+from skimage.measure import marching_cubes
 
 #: Capsules (start, end, radius) of S1: the trunk and the two daughters.
 S1_CAPSULES = (
@@ -81,9 +83,6 @@ def mesh_level_set(function, step: float, low, high):
 
     Returns a closed, consistently outward-oriented ``trimesh.Trimesh`` without degenerate faces.
     """
-    import trimesh
-    from skimage.measure import marching_cubes
-
     # Grid nodes at GRID_ORIGIN + step * integers: the same nodes whatever the box, and off the
     # axes and end points of the capsules.
     low = GRID_ORIGIN + step * np.floor((np.asarray(low, float) - GRID_ORIGIN) / step - 2)

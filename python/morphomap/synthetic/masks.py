@@ -17,6 +17,10 @@ Made here from shapes the package already has, so that the wheel carries no imag
 from __future__ import annotations
 
 import numpy as np
+from skimage.draw import polygon
+
+from ..io import load_example
+from .lung import s1_function, s2_function
 
 #: Microns per unit of the shapes the frames are made from.
 KIDNEY_SCALE = 60.0
@@ -37,10 +41,6 @@ def _voxel_centres(low, high, spacing):
 
 def kidney_masks(spacing: float = 0.65):
     """``(mask1, mask2, (spacing, spacing))``: the kidney pair as boolean (rows, columns) masks."""
-    from skimage.draw import polygon
-
-    from ..io import load_example
-
     curves = [c * KIDNEY_SCALE for c in load_example("kidney")]
     low = np.min([c.min(axis=0) for c in curves], axis=0) - 10.0
     high = np.max([c.max(axis=0) for c in curves], axis=0) + 10.0
@@ -68,8 +68,6 @@ def ellipsoid_stacks(spacing=(2.0, 0.5, 0.5)):
 
 def lung_stacks(spacing=(2.0, 1.0, 1.0), growth: float = 0.6):
     """``(stack1, stack2, spacing)``: the lung-like pair (S1 inside S2) as boolean [z, y, x] stacks."""
-    from .lung import s1_function, s2_function
-
     low, high = np.array([-1.6, -1.0, -2.0]) * LUNG_SCALE, np.array([1.6, 1.0, 1.6]) * LUNG_SCALE
     X, Y, Z = _voxel_centres(low, high, spacing)
     points = np.stack([X, Y, Z], axis=-1) / LUNG_SCALE
