@@ -19,13 +19,18 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+import tifffile
 
 from .._core import METHODS, GeometryError
 from ..chooser import BEST
-from ..io import EXAMPLES, load_example, write_curve, write_field
+from ..images import boundary_from_mask, read_image, surface_from_mask
+from ..io import EXAMPLES, load_example, write_curve, write_field, write_surface
 from ..io.atomic import atomic_text
 from ..mapping import map_curves
+from ..plot import offscreen_figure, plot_field, plot_field_3d, save_figure
 from ..quality import quality
+from ..surfaces import map_surfaces
+from ..synthetic.masks import ellipsoid_stacks, kidney_masks, lung_stacks
 
 #: The paper's basic algorithms in 2D, in the order of the core's method table, and the variants
 #: the demo runs for each; then the basic algorithms beyond the paper, and "best".
@@ -97,9 +102,7 @@ def _write_quality(path, rows, defects="crossings"):
 
 
 def _figure(rows, cols, size):
-    from matplotlib.figure import Figure  # no pyplot: nothing is shown, figures are freed with them
-
-    fig = Figure(figsize=(size * cols, size * rows), layout="constrained")
+    fig = offscreen_figure(size * cols, size * rows)
     return fig, fig.subplots(rows, cols, squeeze=False)
 
 
@@ -110,8 +113,6 @@ def run(out="morphomap-demo", *, pairs=EXAMPLES, stream=None, plots=True) -> lis
     ``NAME/METHOD_VARIANT.csv`` (the field) and ``.png`` (its picture, unless ``plots=False``),
     ``NAME/all.png`` (the grid), and ``quality.csv`` with the table.
     """
-    from ..plot import plot_field, save_figure
-
     stream = sys.stdout if stream is None else stream
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -223,6 +224,16 @@ def run(out="morphomap-demo", *, pairs=EXAMPLES, stream=None, plots=True) -> lis
     return rows + run_images(out / "images", stream=stream, plots=plots)
 
 
+def command(args, parser) -> int:
+    """``morphomap demo``: :func:`run` into ``--out``; 1 where a mapping failed."""
+    rows = run(args.out)
+    failed = [row for row in rows if row.note.startswith("failed")]
+    if failed:
+        print(f"morphomap demo: {len(failed)} mappings failed (see the table)", file=sys.stderr)
+        return 1
+    return 0
+
+
 #: The 3D frames of the image demo and the algorithms run on each: the paper's Figure 12 case
 #: with its three algorithms, the lung-like pair with normal mapping (it folds) and auto.
 STACKS = {"figure12": tuple(row.name for row in METHODS if row.basic and row.from_paper and row.surfaces),
@@ -231,8 +242,6 @@ STACKS = {"figure12": tuple(row.name for row in METHODS if row.basic and row.fro
 
 def _write_frames(folder, name, first, second, spacing):
     """Both frames as ImageJ TIFFs with their physical spacing, as a microscope's software writes."""
-    import tifffile
-
     paths = []
     for k, frame in enumerate((first, second)):
         path = folder / f"{name}_t{k}.tif"
@@ -252,12 +261,6 @@ def run_images(out="morphomap-demo/images", *, stream=None, plots=True) -> list:
     ``.ply`` surfaces), the fields (``.csv``, 3D with faces) and figures (``.png``), and prints
     one table for 2D and one for 3D. Returns the rows.
     """
-    from ..images import boundary_from_mask, read_image, surface_from_mask
-    from ..io import write_surface
-    from ..plot import plot_field, plot_field_3d
-    from ..surfaces import map_surfaces
-    from ..synthetic.masks import ellipsoid_stacks, kidney_masks, lung_stacks
-
     stream = sys.stdout if stream is None else stream
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -315,8 +318,6 @@ def run_images(out="morphomap-demo/images", *, stream=None, plots=True) -> list:
 
 def _image_row(pair, method, mapping, b1, b2, stem, draw, plots, projection=None) -> Row:
     """Run one mapping of the image demo; write its field and figure; its row of the table."""
-    from ..plot import save_figure
-
     row = Row(pair, method, "plain")
     tick = time.perf_counter()
     try:
@@ -331,9 +332,7 @@ def _image_row(pair, method, mapping, b1, b2, stem, draw, plots, projection=None
     row.misses, row.vectors = int((~field.valid).sum()), len(field)
     write_field(stem.with_suffix(".csv"), field)
     if plots:
-        from matplotlib.figure import Figure
-
-        figure = Figure(figsize=(7, 7), layout="constrained")
+        figure = offscreen_figure(7, 7)
         names, counts = np.unique(field.method, return_counts=True)
         used = ", ".join(f"{n} {c}" for n, c in zip(names, counts))
         draw(

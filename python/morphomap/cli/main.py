@@ -3,17 +3,15 @@
 from __future__ import annotations
 
 import argparse
-import os
 import sys
-import warnings
+from importlib import import_module
 
-import numpy as np
+from .. import build_info
+from ..mapping import CURVE_METHODS
 
 
 def _info(args) -> int:
-    import morphomap
-
-    info = morphomap.build_info()
+    info = build_info()
     print(f"morphomap {info['version']}")
     print(f"CGAL      {info['cgal']}")
     print(f"Embree    {info['embree']}")
@@ -23,219 +21,16 @@ def _info(args) -> int:
     return 0
 
 
-def _demo(args) -> int:
-    from .demo import run
+def _command(module: str, name: str, parser):
+    """The subcommand: ``name`` of this package's ``module``, called with the arguments and the
+    subcommand's ``parser`` (for its error messages)."""
+    def run(args) -> int:
+        # Imported when the subcommand runs: its module imports what it maps, reads, draws or
+        # distributes with (trimesh, scipy, matplotlib, distributed: about a second), which --help
+        # and info do without.
+        return getattr(import_module(f".{module}", __package__), name)(args, parser)
 
-    rows = run(args.out)
-    failed = [row for row in rows if row.note.startswith("failed")]
-    if failed:
-        print(f"morphomap demo: {len(failed)} mappings failed (see the table)", file=sys.stderr)
-        return 1
-    return 0
-
-
-def _read_and_map(args, parser):
-    """The two frames of `map` / `extend`, the field between them and its quality."""
-    import morphomap
-
-    frames = []
-    for path in (args.c1, args.c2):
-        try:
-            frames.append(_read_frame(path, args))
-        except OSError as error:
-            parser.error(f"cannot read {path}: {error.strerror or error}")
-        except (ValueError, TypeError) as error:
-            parser.error(f"{path}: {error}")
-    (c1, from_image), (c2, _) = frames
-    surfaces = [not isinstance(frame, np.ndarray) for frame in (c1, c2)]
-    if surfaces[0] != surfaces[1]:
-        parser.error(f"{args.c1} is a {'surface' if surfaces[0] else 'curve'} but {args.c2} is a "
-                     f"{'surface' if surfaces[1] else 'curve'}: map two of a kind")
-    try:
-        if surfaces[0]:
-            for option, given in _CURVE_ONLY.items():
-                if given(args):
-                    parser.error(f"{option} applies to curves, not to surfaces")
-            field = morphomap.map_surfaces(c1, c2, args.method, reverse=args.reverse, mesh_size=args.mesh_size)
-            q = morphomap.quality(field, c1, c2)
-        else:
-            # A traced contour that make_simple repairs is mapped repaired: say so on stderr.
-            with warnings.catch_warnings(record=True) as told:
-                warnings.simplefilter("always", UserWarning)
-                field = morphomap.map_curves(c1, c2, args.method, closed=args.closed, n=args.n,
-                                             reverse=args.reverse, transform=args.transform, split=args.split,
-                                             contact_tolerance=args.contact_tolerance, mesh_size=args.mesh_size)
-            for warning in told:
-                print(f"morphomap: warning: {warning.message}", file=sys.stderr)
-            q = morphomap.quality(field, c1, c2, closed=args.closed)
-    except (ValueError, TypeError, morphomap.InvalidInput, morphomap.GeometryError) as error:
-        parser.error(f"cannot map {args.c1} onto {args.c2} with --method {args.method}: {error}")
-    return c1, c2, from_image, field, q
-
-
-def _summary(field, q) -> str:
-    names, counts = np.unique(field.method, return_counts=True)
-    used = ", ".join(f"{name} {count}" for name, count in zip(names, counts))
-    defects = f"folds {q.folds}" if field.dim == 3 else f"crossings {q.crossings}"
-    return (f"{len(field)} vectors, {int(field.valid.sum())} valid, {int((~field.valid).sum())} missed ({used}); "
-            f"QM1 {q.qm1:.4g}  QM2 {q.qm2:.4g}  QM {q.qm:.4g}  {defects}")
-
-
-def _map(args, parser) -> int:
-    import morphomap
-    from ..io.formats import writer
-
-    # "-" and a device such as /dev/null are streams: CSV, as to an open text file.
-    stream = args.output == "-" or (os.path.exists(args.output) and not os.path.isfile(args.output))
-    if not stream:
-        try:
-            writer(args.output, "field")  # an unknown suffix before the work, not a traceback after it
-        except ValueError as error:
-            parser.error(f"-o {args.output}: {error}")
-    c1, c2, from_image, field, q = _read_and_map(args, parser)
-    title = f"{args.method}: QM1 {q.qm1:.4g}  QM2 {q.qm2:.4g}  QM {q.qm:.4g}"
-    try:
-        if args.output == "-":
-            morphomap.write_field(sys.stdout, field)
-        elif stream:
-            with open(args.output, "w") as device:
-                morphomap.write_field(device, field)
-        else:
-            morphomap.write_field(args.output, field)
-        if args.plot:
-            from matplotlib.figure import Figure
-
-            from ..plot import plot_field, plot_field_3d, save_figure
-
-            fig = Figure(figsize=(7, 7), layout="constrained")
-            if field.dim == 3:
-                plot_field_3d(field, c1, c2, ax=fig.add_subplot(projection="3d"), title=title)
-            else:
-                plot_field(field, c1, c2, ax=fig.subplots(), closed=args.closed, title=title, y_down=from_image)
-            save_figure(fig, args.plot, dpi=100)
-    except OSError as error:
-        parser.error(f"cannot write {error.filename}: {error.strerror or error}")
-    where = "" if args.output == "-" else f"; field written to {args.output}"
-    where += f", plot to {args.plot}" if args.plot else ""
-    print(_summary(field, q) + where, file=sys.stderr)
-    if field.candidates is not None:  # --method best: every candidate it tried
-        from ..best import candidate_table
-
-        print(candidate_table(field), file=sys.stderr)
-    return 0
-
-
-def _extend(args, parser) -> int:
-    import morphomap
-    from ..io.formats import writer
-
-    try:
-        writer(args.output, "interior")  # an unknown suffix before the work, not after it
-    except ValueError as error:
-        parser.error(f"-o {args.output}: {error}")
-    _, _, _, field, q = _read_and_map(args, parser)
-    mesh = None
-    if args.mesh:
-        import meshio
-
-        try:
-            solver_mesh = meshio.read(args.mesh)
-        except (OSError, ValueError, KeyError, meshio.ReadError) as error:
-            parser.error(f"cannot read the mesh {args.mesh}: {error}")
-        kind = "triangle" if field.dim == 2 else "tetra"
-        if kind not in solver_mesh.cells_dict:
-            parser.error(f"{args.mesh}: has no {kind} cells (found: {', '.join(solver_mesh.cells_dict) or 'none'})")
-        mesh = (solver_mesh.points[:, : field.dim], solver_mesh.cells_dict[kind])
-    try:
-        interior = morphomap.extend_field(field, mesh=mesh, mesh_size=args.extend_mesh_size, method=args.extension,
-                                          poisson_ratio=args.poisson_ratio, substeps=args.substeps,
-                                          untangle=args.untangle)
-    except (ValueError, TypeError, morphomap.InvalidInput, morphomap.GeometryError) as error:
-        parser.error(f"cannot extend the field into {args.mesh or 'the domain'}: {error}")
-    try:
-        morphomap.write_interior(args.output, interior, dt=args.dt)
-    except OSError as error:
-        parser.error(f"cannot write {error.filename}: {error.strerror or error}")
-    tried = ", ".join(f"{s} substep{'s' if s > 1 else ''}{' + untangle' if u else ''}: "
-                      f"{'no solution' if n is None else f'{n} inverted'}" for s, u, n, _ in interior.attempts)
-    print(f"{_summary(field, q)}; {interior!r} (tried {tried}), boundary nodes within "
-          f"{interior.boundary_distance:.3g} of C1; written to {args.output}", file=sys.stderr)
-    return 0
-
-
-# Options of `map` that only curves have, and how to tell that one was given.
-_CURVE_ONLY = {
-    "--n": lambda args: args.n is not None,
-    "--open": lambda args: not args.closed,
-    "--transform": lambda args: args.transform,
-    "--no-split": lambda args: not args.split,
-    "--contact-tolerance": lambda args: args.contact_tolerance is not None,
-}
-
-
-def _series(args, parser) -> int:
-    import morphomap
-
-    frames = []
-    for path in args.frames:
-        try:
-            frames.append(_read_frame(path, args)[0])
-        except OSError as error:
-            parser.error(f"cannot read {path}: {error.strerror or error}")
-        except (ValueError, TypeError) as error:
-            parser.error(f"{path}: {error}")
-    try:
-        series = morphomap.map_series(frames, args.method, dt=args.dt, reseed=args.reseed,
-                                      progress=False if args.no_progress else None)
-    except (ValueError, TypeError, morphomap.InvalidInput, morphomap.GeometryError) as error:
-        parser.error(str(error))
-    try:
-        written = series.write(args.out)
-    except OSError as error:
-        parser.error(f"cannot write {error.filename}: {error.strerror or error}")
-    for q in series.quality:
-        kind = "crossings" if series.dim == 2 else "folds"
-        print(f"step {q.step}: QM1 {q.qm1:.4g}  QM2 {q.qm2:.4g}  QM {q.qm:.4g}  {kind} {q.defects}  misses {q.misses}  "
-              f"{q.seconds:.2f} s", file=sys.stderr)
-    print(f"{series!r}; {len(written)} files written to {args.out}", file=sys.stderr)
-    return 0
-
-
-def _batch(args, parser) -> int:
-    import csv
-    import os
-
-    from ..batch import Job, map_batch
-
-    try:
-        with open(args.manifest, newline="", encoding="utf-8") as handle:
-            rows = [row for row in csv.reader(handle) if row and not row[0].startswith("#")]
-    except OSError as error:
-        parser.error(f"cannot read {args.manifest}: {error.strerror or error}")
-    if rows and rows[0][:2] == ["c1", "c2"]:
-        rows = rows[1:]
-    base = os.path.dirname(os.path.abspath(args.manifest))
-    os.makedirs(args.out, exist_ok=True)
-    jobs = []
-    for number, row in enumerate(rows, start=1):
-        if len(row) not in (2, 3):
-            parser.error(f"{args.manifest}: row {number}: expected c1,c2[,method], got {len(row)} values")
-        c1, c2 = (p if os.path.isabs(p) else os.path.join(base, p) for p in row[:2])
-        stem = f"{number:03d}_{os.path.splitext(os.path.basename(c1))[0]}_{os.path.splitext(os.path.basename(c2))[0]}"
-        jobs.append(Job(c1, c2, os.path.join(args.out, stem + ".csv"), row[2] if len(row) == 3 else args.method,
-                        args.spacing, args.smooth))
-    client = None
-    if args.scheduler:
-        from distributed import Client
-
-        client = Client(args.scheduler)
-    results = map_batch(jobs, client=client, workers=args.workers, progress=False if args.no_progress else None)
-    for r in results:
-        print(f"{r.status:8s} {r.job.c1} -> {r.job.c2}: {r.message}", file=sys.stderr)
-    failed = sum(r.status == "failed" for r in results)
-    print(f"{len(results)} jobs: {len(results) - failed} done or skipped, {failed} failed; fields in {args.out}",
-          file=sys.stderr)
-    return 1 if failed else 0
+    return run
 
 
 def _share(common, parser, options) -> None:
@@ -245,8 +40,6 @@ def _share(common, parser, options) -> None:
 
 
 def main(argv=None) -> int:
-    from ..mapping import CURVE_METHODS
-
     parser = argparse.ArgumentParser(prog="morphomap", description="Displacement fields between growing boundaries.")
     commands = parser.add_subparsers(dest="command", required=True)
     info = commands.add_parser(
@@ -262,7 +55,7 @@ def main(argv=None) -> int:
     demo.add_argument(
         "--out", default="morphomap-demo", metavar="DIR", help="folder to write into (default: ./morphomap-demo)"
     )
-    demo.set_defaults(run=_demo)
+    demo.set_defaults(run=_command("demo", "command", demo))
     common = argparse.ArgumentParser(add_help=False)
     common.add_argument(
         "c1", metavar="C1", help="the boundary at time t: a CSV curve, a mesh file, a 2D mask or a 3D stack"
@@ -345,7 +138,7 @@ def main(argv=None) -> int:
         metavar="FIELD.png",
         help="also draw the field into this image file (2D masks: y down, as the image looks)",
     )
-    mapping.set_defaults(run=lambda args: _map(args, mapping))
+    mapping.set_defaults(run=_command("pair", "run_map", mapping))
     extend = commands.add_parser(
         "extend",
         parents=[common],
@@ -373,7 +166,7 @@ def main(argv=None) -> int:
                         help="the time between the frames: also write the velocity")
     extend.add_argument("-o", "--output", required=True, metavar="U.xdmf",
                         help="where to write the interior displacement (.xdmf, .vtu or a COMSOL .txt)")
-    extend.set_defaults(run=lambda args: _extend(args, extend))
+    extend.set_defaults(run=_command("pair", "run_extend", extend))
     series = commands.add_parser(
         "series",
         help="map every consecutive pair of a time series and follow the first frame's points",
@@ -401,7 +194,7 @@ def main(argv=None) -> int:
         "first frame's spacing apart (default 2; 'none': follow only the first frame's points)",
     )
     series.add_argument("--no-progress", action="store_true", help="no progress bar (default: one on a terminal)")
-    series.set_defaults(run=lambda args: _series(args, series))
+    series.set_defaults(run=_command("series", "run", series))
     batch = commands.add_parser(
         "batch",
         help="map many pairs on Dask distributed (a local cluster, or --scheduler)",
@@ -421,28 +214,13 @@ def main(argv=None) -> int:
     )
     _share(common, batch, ("--spacing", "--smooth", "--method"))
     batch.add_argument("--no-progress", action="store_true", help="no progress bar (default: one on a terminal)")
-    batch.set_defaults(run=lambda args: _batch(args, batch))
+    batch.set_defaults(run=_command("batch", "run", batch))
     args = parser.parse_args(argv)
     try:
         return args.run(args)
     except KeyboardInterrupt:
         print("morphomap: interrupted", file=sys.stderr)
         return 130
-
-
-def _read_frame(path: str, args):
-    """``(frame, from_image)`` for the command line: read_boundary with its options, the spacing
-    used said on stderr."""
-    from ..io.frames import read_boundary
-
-    return read_boundary(
-        path,
-        spacing=args.spacing,
-        label=args.label,
-        smooth=args.smooth,
-        edge_length=args.edge_length,
-        report=lambda text: print(text, file=sys.stderr),
-    )
 
 
 def _spacing(text: str) -> tuple:
