@@ -10,7 +10,8 @@ __getattr__, __dir__ = lazy_names(__name__, globals(), {
     "csv_files": ("read_curve", "read_field", "write_curve"),
     "examples": ("EXAMPLES", "example_path", "load_example"),
     "formats": ("FORMATS", "write_field", "write_interior", "write_interior_series"),
-    "meshes": ("SURFACE_SUFFIXES", "read_surface", "write_surface"),
+    "meshes": ("read_surface", "write_surface"),
+    "suffixes": ("SURFACE_SUFFIXES",),
 })
 
 __all__ = ["EXAMPLES", "FORMATS", "SURFACE_SUFFIXES", "example_path", "load_example", "read_curve", "read_field",

@@ -11,8 +11,7 @@ import trimesh
 from .. import _core
 from ..prepared import as_surface
 from .atomic import atomic_path
-
-SURFACE_SUFFIXES = (".stl", ".ply", ".obj", ".off")
+from .suffixes import SURFACE_SUFFIXES
 
 
 def _suffix(path, name: str) -> str:
