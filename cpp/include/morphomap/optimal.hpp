@@ -28,8 +28,8 @@ struct MonotoneMatch {
 // source.row(last) -> target.row(last); a start point that is row 0 or the last row is pinned to
 // the target's end). Ends are chosen among M + 1 equally spaced target positions t_k = k L / M,
 // M = max(4 (n + 1), min(target vertices, 8 (n + 1))), joined by the uniform map's position
-// alpha s_i of each start and, on a target with an edge over 4 times its median, by M - 1
-// positions spaced evenly through its vertices; strictly increasing, minimising
+// alpha s_i of each start (on a target with an edge over 4 times its median, half of the M + 1
+// spaced evenly along it and half evenly through its vertices); strictly increasing, minimising
 //
 //   E = sum_i |p_i - q_i|^2 / g^2  +  w * sum_pairs (L_j / (alpha l_j) - 1)^2
 //

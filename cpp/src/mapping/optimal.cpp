@@ -93,24 +93,27 @@ struct Level {
 
 // The arc positions of the target samples of one level, strictly increasing, the ends exact
 // (positions within 1e-9 of the target's length of a kept one dropped):
-// - M + 1 equally spaced ones;
-// - on a target with uneven edges (one longer than kUneven times the median), also M - 1 at the
-//   same fractions of the way through the target's vertices: outlines are traced densely where
-//   they have detail and sparsely along long edges (a flank closed by one segment), equally spaced
-//   samples alone are coarser than the points there, and the stretch term, which compares arc
-//   lengths between neighbours, then only sees multiples of the sample step. Taking both rather
-//   than their mean maps fingers 5 and 6 long (tests/test_optimal.py);
+// - M + 1 equally spaced ones on a target with even edges;
+// - on one with uneven edges (one longer than kUneven times the median), half of them equally
+//   spaced and half at equal fractions of the way through the target's vertices: outlines are
+//   traced densely where they have detail and sparsely along long edges (a flank closed by one
+//   segment), equally spaced samples alone are coarser than the points there, and the stretch
+//   term, which compares arc lengths between neighbours, then only sees multiples of the sample
+//   step. Taking both rather than their mean maps fingers 5 and 6 long (tests/test_optimal.py);
+//   M of them in all, as the DP's cost grows with the square of the samples;
 // - the uniform map's position alpha * s of each of the level's starts, where the stretch term
 //   is zero: a start a hair from a piece's end on a long target edge (the limb's flank, where the
 //   curves cross on it) otherwise lands a whole sample step away; limb 300 -> 301 h closed went
 //   from QM 14 to 0.0013 (bench/README.md, "Real 2D outlines").
 std::vector<double> sample_arcs(const Problem& p, Index samples, const std::vector<Index>& rows) {
-  std::vector<double> t(samples + 1);
-  for (Index k = 0; k <= samples; ++k) t[k] = static_cast<double>(k) / static_cast<double>(samples) * p.target_length;
+  const Index even = p.uneven_target ? (samples + 1) / 2 : samples;
+  std::vector<double> t(even + 1);
+  for (Index k = 0; k <= even; ++k) t[k] = static_cast<double>(k) / static_cast<double>(even) * p.target_length;
   if (p.uneven_target) {
     const Index last_vertex = static_cast<Index>(p.vertex_arcs.size()) - 1;
-    for (Index k = 1; k < samples; ++k) {
-      const double x = static_cast<double>(k) / static_cast<double>(samples) * static_cast<double>(last_vertex);
+    const Index through = samples - even;
+    for (Index k = 1; k < through; ++k) {
+      const double x = static_cast<double>(k) / static_cast<double>(through) * static_cast<double>(last_vertex);
       const Index j = std::min<Index>(static_cast<Index>(x), last_vertex - 1);
       const double f = x - static_cast<double>(j);
       t.push_back(p.vertex_arcs[j] + f * (p.vertex_arcs[j + 1] - p.vertex_arcs[j]));
