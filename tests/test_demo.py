@@ -52,7 +52,8 @@ def test_demo_runs_every_algorithm_and_writes_everything(tmp_path):
     # From images: the frames are TIFFs a user can map again with the command line; every field of
     # the table is on disk with its figure and its measures hold when recomputed.
     images = tmp_path / "out" / "images"
-    assert mm.read_image(images / "figure12_t0.tif").spacing == (2.0, 0.5, 0.5)
+    stack = mm.read_image(images / "figure12_t0.tif")
+    assert (stack.axes, stack.spacing, stack.unit, stack.frame_interval) == ("ZYX", (2.0, 0.5, 0.5), "um", None)
     for pair, method in [("kidney", "normal"), ("kidney", "diffusion"), ("kidney", "auto"),
                          *[(name, m) for name, methods in demo.STACKS.items() for m in methods]]:
         kind = "masks" if pair == "kidney" else "stacks"

@@ -1,5 +1,5 @@
-"""Segmented images in: reading masks and stacks with their spacing, and the boundary of a mask as
-a curve (2D) or a remeshed surface (3D)."""
+"""Segmented images in: reading masks, stacks and movies with their axes, spacing, unit and frame
+interval, and the boundary of a mask as a curve (2D) or a remeshed surface (3D)."""
 
 from .masks import boundary_from_mask, surface_from_mask
 from .read import Image, read_image

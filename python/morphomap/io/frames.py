@@ -18,25 +18,38 @@ def read_boundary(path, *, spacing=None, label=None, smooth=None, edge_length=No
 
     ``smooth``: as :func:`boundary_from_mask` and :func:`surface_from_mask` take it; None is
     each one's default (a sub-pixel outline of a 2D mask, a 3D stack unsmoothed).
-    ``report``, given, is called with one line saying which spacing was used.
+    ``report``, given, is called with one line saying which spacing was used (with its unit, when
+    it comes from the file: micrometres, :func:`read_image`'s default).
+
+    An image with a T axis (a movie) or a C axis (RGB or channels) is refused with a ValueError
+    saying so: a movie is mapped by ``morphomap series`` / :func:`map_series`, an RGB picture is
+    segmented first.
     """
     name = os.fspath(path)
     if name.lower().endswith(SURFACE_SUFFIXES):
         return morphomap.read_surface(name), False
     if not name.lower().endswith(IMAGE_SUFFIXES):
         return morphomap.read_curve(name), False
-    data, stated = morphomap.read_image(name)
+    image = morphomap.read_image(name)
+    data, axes = image.data, image.axes
+    if "T" in axes:
+        raise ValueError(f"{name}: a movie (axes {axes}, {data.shape[axes.index('T')]} time points), not one frame: "
+                         f"map it with `morphomap series` / map_series, which take the movie")
+    if "C" in axes:
+        raise ValueError(f"an RGB/multichannel image, not a mask: {name} (axes {axes}, shape {data.shape}): "
+                         f"segment it first and save the mask or label image as one greyscale image")
     if data.ndim not in (2, 3):
         raise ValueError(f"a {data.ndim}D image (shape {data.shape}): expected a 2D mask or a 3D stack")
+    unit = ""
     if spacing is not None:
         spacing, source = tuple(spacing) if hasattr(spacing, "__len__") else (spacing,), "--spacing"
-    elif stated is not None:
-        spacing, source = tuple(float(v) for v in stated), "the file"
+    elif image.spacing is not None:
+        spacing, source, unit = tuple(float(v) for v in image.spacing), "the file", f", in {image.unit}"
     else:
         spacing, source = (1.0,), "no spacing in the file, none given"
     if report is not None:
-        unit = "pixel" if data.ndim == 2 else "voxel"
-        report(f"{name}: {unit} spacing {' x '.join(f'{v:g}' for v in spacing)} ({source})")
+        kind = "pixel" if data.ndim == 2 else "voxel"
+        report(f"{name}: {kind} spacing {' x '.join(f'{v:g}' for v in spacing)} ({source}){unit}")
     if data.ndim == 2:
         return morphomap.boundary_from_mask(data, spacing, label=label, smooth=smooth), True
     return morphomap.surface_from_mask(data, spacing, label=label, smooth=0.0 if smooth is None else smooth,
