@@ -19,6 +19,7 @@ from .curves import normals
 from .io import write_field
 from .io.atomic import atomic_text
 from .mapping import map_curves
+from .movie import Movie, describe_motion, is_movie_path, movie_frames, register_frames
 from .prepared import PreparedCurve, PreparedSurface, as_surface
 from .quality import quality
 from .reseed import reseed_curve, reseed_surface
@@ -78,11 +79,16 @@ class Series:
         those steps divided by the time elapsed.
     quality : list of StepQuality
         One row per step.
+    motion : (T, d + 1, d + 1) float or None
+        With ``register``: the rigid motion (homogeneous matrix) that took each frame as given onto
+        the frame as mapped, the identity for frame 0 (:func:`morphomap.movie.register_frames`);
+        None without.
     """
 
     def __init__(self, frames, fields, trajectories, quality, *, born=None, cells=None, stretches=None,
-                 accumulated=None, normal_speed=None, accumulated_normal_speed=None, dt=1.0):
+                 accumulated=None, normal_speed=None, accumulated_normal_speed=None, dt=1.0, motion=None):
         self.frames, self.fields, self.trajectories, self.quality = frames, fields, trajectories, quality
+        self.motion = motion
         self.born = np.zeros(trajectories.shape[1], dtype=np.int64) if born is None else born
         self.cells, self._stretches, self._accumulated = cells, stretches, accumulated
         self.normal_speed, self.accumulated_normal_speed, self.dt = normal_speed, accumulated_normal_speed, dt
@@ -134,6 +140,8 @@ class Series:
         - ``stretch.csv`` (step, piece, its corner points, stretch, accumulated stretch) and
           ``normal_speed.csv`` (step, point, normal speed, accumulated normal speed) with the
           growth maps;
+        - with ``register``: ``motion.csv`` (frame, the matrix of :attr:`motion` row by row, and
+          the translation and rotation in words);
         - with ``figures``: ``trajectories.png``, ``stretch.png`` and ``normal_speed.png`` (the
           accumulated maps at the last frame), ``series.gif``, and ``series.mp4`` when ffmpeg is
           installed.
@@ -185,6 +193,16 @@ class Series:
                                    self.accumulated_normal_speed[k, rows].tolist()):
                     handle.write(f"{k},{i},{v!r},{m!r}\n")
         paths.append(path)
+        if self.motion is not None:
+            path = os.path.join(folder, "motion.csv")
+            dim = self.dim
+            entries = ",".join(f"m{i}{j}" for i in range(dim + 1) for j in range(dim + 1))
+            with atomic_text(path) as handle:
+                handle.write(f"frame,{entries},description\n")
+                for k, (matrix, line) in enumerate(zip(self.motion, describe_motion(self.motion))):
+                    values = ",".join(repr(float(v)) for v in matrix.ravel())
+                    handle.write(f"{k},{values},\"{line}\"\n")
+            paths.append(path)
         if figures:
             paths.extend(write_figures(self, folder))
         return paths
@@ -196,20 +214,26 @@ class Series:
                 f"{self.trajectories.shape[1]} points followed ({new} born after frame 0), {lost} lost)")
 
 
-def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **options) -> Series:
+def map_series(frames, method="auto", *, dt=None, reseed=2.0, register=None, label=None, objects=None,
+               progress=None, **options) -> Series:
     """Map every consecutive pair of a time series and follow the points of the first frame.
 
     Parameters
     ----------
-    frames : sequence of at least 2 curves ``(N, 2)`` or surfaces (``trimesh.Trimesh`` or
-        ``(vertices, faces)``), all of one kind. Curves as labs trace them (repeated points,
-        one-pixel spurs and necks, a first point across the closing segment) are made simple
-        once each, up front, by :func:`morphomap.make_simple`, with a ``UserWarning`` naming
-        the frame and what changed; :attr:`Series.frames` holds the repaired curves. A curve
-        it cannot repair is passed on as given (its pair's error names it).
+    frames : a movie file, a :class:`morphomap.movie.Movie`, or a sequence of at least 2 curves
+        ``(N, 2)`` or surfaces (``trimesh.Trimesh`` or ``(vertices, faces)``), all of one kind.
+        A file (an ImageJ hyperstack or OME-TIFF of masks or labels with a T axis, 2D or 3D) is
+        read by :func:`morphomap.movie.movie_frames` with ``label`` and ``objects``: one boundary
+        per time point in the file's spacing (µm), its frame interval as ``dt``. Curves as labs
+        trace them (repeated points, one-pixel spurs and necks, a first point across the closing
+        segment) are made simple once each, up front, by :func:`morphomap.make_simple`, with a
+        ``UserWarning`` naming the frame and what changed; :attr:`Series.frames` holds the
+        repaired curves. A curve it cannot repair is passed on as given (its pair's error names
+        it).
     method : the mapping algorithm for every pair (``"auto"`` by default).
-    dt : float
-        The time between two frames (for the normal speeds).
+    dt : float, optional
+        The time between two frames (for the normal speeds); default: a movie's frame interval
+        (seconds), else 1.
     reseed : float or None
         Keep the boundary sampled: on every frame after the first, where two neighbouring followed
         points are more than ``reseed`` times the spacing of frame 0 apart (the median distance
@@ -221,6 +245,12 @@ def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **op
         frame's surface (the two triangles sharing it become four), until no edge is longer. New
         points are followed from then on (their rows of ``trajectories`` are NaN before; ``born`` gives their frame).
         ``None`` follows only the points of frame 0. Default 2.
+    register : {"translation", "rigid"}, optional
+        Remove the sample's drift first: each frame moved (and with ``"rigid"`` turned) onto the
+        previous one (:func:`morphomap.movie.register_frames`); :attr:`Series.frames` are the
+        frames as moved and :attr:`Series.motion` says by how much.
+    label, objects : optional
+        Only with a movie file: which object each frame gives (:func:`morphomap.movie.movie_frames`).
     progress : bool, optional
         One progress bar (tqdm) on stderr counting the pairs; by default shown when stderr is a
         terminal and the call runs longer than 3 seconds, ``True``: at once, ``False``: never. The
@@ -242,6 +272,13 @@ def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **op
     ValueError, GeometryError
         A frame or pair that cannot be mapped, named: ``"frames[k] -> frames[k + 1]: ..."``
     """
+    if is_movie_path(frames) or isinstance(frames, Movie):
+        movie = frames if isinstance(frames, Movie) else movie_frames(frames, label=label, objects=objects)
+        frames = movie.frames
+        dt = movie.dt if dt is None else dt
+    elif label is not None or objects is not None:
+        raise ValueError("label/objects: only for a movie file (frames given as a path); pick the object "
+                         "before passing the frames")
     frames = list(frames)
     if len(frames) < 2:
         raise ValueError(f"frames: expected at least 2, got {len(frames)}")
@@ -258,6 +295,9 @@ def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **op
     closed = bool(options.get("closed", True)) if curves[0] else True
     if curves[0]:
         frames = _simple_frames(frames, closed)
+    motion = None
+    if register is not None:
+        frames, motion = register_frames(frames, register)
     boundary = _CurveBoundary(frames, closed) if curves[0] else _SurfaceBoundary(frames)
     positions = [boundary.first.copy()]  # per frame: every point born so far
     born = np.zeros(len(boundary.first), dtype=np.int64)
@@ -324,7 +364,8 @@ def map_series(frames, method="auto", *, dt=1.0, reseed=2.0, progress=None, **op
     for k, (v, m) in enumerate(zip(speeds, mean_speeds)):
         speed_table[k, : len(v)], mean_table[k, : len(m)] = v, m
     return Series(frames, fields, trajectories, table, born=born, cells=cells, stretches=stretches,
-                  accumulated=accumulated, normal_speed=speed_table, accumulated_normal_speed=mean_table, dt=dt)
+                  accumulated=accumulated, normal_speed=speed_table, accumulated_normal_speed=mean_table, dt=dt,
+                  motion=motion)
 
 
 def _simple_frames(frames, closed: bool) -> list:

@@ -170,7 +170,8 @@ def main(argv=None) -> int:
     series = commands.add_parser(
         "series",
         help="map every consecutive pair of a time series and follow the first frame's points",
-        description="Map frame k onto frame k + 1 for every k (curves, surfaces, masks or stacks, all of one kind) "
+        description="Map frame k onto frame k + 1 for every k (curves, surfaces, masks or stacks, all of one kind; "
+        "or one movie file, an ImageJ hyperstack or OME-TIFF with a T axis, 2D or 3D) "
         "and carry the points of the first frame through the fields, with new points born where they "
         "spread apart; write the fields, the trajectories, the growth maps (stretch, normal speed), "
         "the quality per step, figures and an animation (GIF; MP4 when ffmpeg is there) into --out.",
@@ -181,10 +182,18 @@ def main(argv=None) -> int:
     series.add_argument(
         "--dt",
         type=lambda text: _length(text, positive=True),
-        default=1.0,
+        default=None,
         metavar="DT",
-        help="the time between two frames, for the normal speeds (default 1)",
+        help="the time between two frames, for the normal speeds (default: a movie's frame interval in seconds, "
+        "else 1)",
     )
+    series.add_argument("--objects", choices=("union", "largest", "follow"), default=None,
+                        help="one movie file of labels not linked across frames: every label (union, the default "
+                        "without --label), the largest in each frame, or the object followed by overlap from "
+                        "--label (or the largest) in the first frame")
+    series.add_argument("--register", choices=("translation", "rigid"), default=None,
+                        help="remove the sample's drift: move (rigid: and turn) each frame onto the previous one; "
+                        "the motion is printed and written to motion.csv")
     series.add_argument(
         "--reseed",
         type=_reseed,

@@ -5,13 +5,34 @@ from __future__ import annotations
 import sys
 
 from .._core import GeometryError, InvalidInput
+from ..movie import describe_motion, movie_frames
 from ..series import map_series
 from .frames import read_frame
 
 
+def _movie(path: str, args):
+    """One file given: a movie, its frames read with the options given."""
+    movie = movie_frames(path, label=args.label, objects=args.objects, smooth=args.smooth,
+                         edge_length=args.edge_length, spacing=args.spacing)
+    unit = movie.unit or "pixel"
+    interval = "no frame interval in the file" if movie.dt is None else f"frame interval {movie.dt:g} s"
+    print(f"{path}: {len(movie.frames)} time points, spacing {' x '.join(f'{v:g}' for v in movie.spacing)} "
+          f"{unit}, {interval}", file=sys.stderr)
+    return movie
+
+
 def run(args, parser) -> int:
     frames = []
-    for path in args.frames:
+    if len(args.frames) == 1:
+        try:
+            frames = _movie(args.frames[0], args)
+        except OSError as error:
+            parser.error(f"cannot read {args.frames[0]}: {error.strerror or error}")
+        except (ValueError, TypeError) as error:
+            parser.error(f"{args.frames[0]}: {error}")
+    elif args.objects is not None:
+        parser.error("--objects: only with one movie file")
+    for path in args.frames if len(args.frames) > 1 else ():
         try:
             frames.append(read_frame(path, args)[0])
         except OSError as error:
@@ -19,10 +40,13 @@ def run(args, parser) -> int:
         except (ValueError, TypeError) as error:
             parser.error(f"{path}: {error}")
     try:
-        series = map_series(frames, args.method, dt=args.dt, reseed=args.reseed,
-                                      progress=False if args.no_progress else None)
+        series = map_series(frames, args.method, dt=args.dt, reseed=args.reseed, register=args.register,
+                            progress=False if args.no_progress else None)
     except (ValueError, TypeError, InvalidInput, GeometryError) as error:
         parser.error(str(error))
+    if series.motion is not None:
+        for line in describe_motion(series.motion):
+            print(line, file=sys.stderr)
     try:
         written = series.write(args.out)
     except OSError as error:
