@@ -207,3 +207,33 @@ def test_cli_series_from_a_movie(tmp_path):
     assert done.returncode == 0, done.stderr
     assert "frame interval 300 s" in done.stderr and "frame 2: moved by" in done.stderr
     assert (tmp_path / "out" / "motion.csv").exists() and (tmp_path / "out" / "field_01.csv").exists()
+
+
+@pytest.mark.parametrize("kind", ["imagej", "ome"])
+@pytest.mark.parametrize("axes", ["TYX", "TZYX"])
+@pytest.mark.parametrize("length, unit", [(0.65, "um"), (650.0, "nm")])
+def test_series_from_imagej_and_ome_movies(tmp_path, kind, axes, length, unit):
+    # A growing disc or ball, written as Fiji or an OME pipeline would, calibrated in µm or nm:
+    # the series' frames come out in µm and dt in seconds, whichever way the file says them.
+    if axes == "TYX":
+        rows, columns = np.mgrid[:60, :60]
+        movie = np.array([np.hypot(rows - 30, columns - 30) < 12 + 3 * t for t in range(3)], dtype=np.uint8)
+    else:
+        z, y, x = np.mgrid[:24, :36, :36]
+        movie = np.array([np.hypot(np.hypot(z - 12, y - 18), x - 18) < 6 + 2 * t for t in range(3)], dtype=np.uint8)
+    path = tmp_path / f"movie.{kind}.tif"
+    if kind == "imagej":
+        tifffile.imwrite(path, movie, imagej=True, resolution=(1 / length, 1 / length),
+                         metadata={"axes": axes, "unit": unit, "spacing": length, "finterval": 2.5, "tunit": "min"})
+    else:
+        tifffile.imwrite(path, movie, ome=True, metadata={
+            "axes": axes, "PhysicalSizeX": length, "PhysicalSizeXUnit": "µm" if unit == "um" else unit,
+            "PhysicalSizeY": length, "PhysicalSizeYUnit": "µm" if unit == "um" else unit, "PhysicalSizeZ": length,
+            "PhysicalSizeZUnit": "µm" if unit == "um" else unit, "TimeIncrement": 150, "TimeIncrementUnit": "s"})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # inside the image: nothing to warn about
+        series = mm.map_series(path, progress=False)
+    assert series.dt == pytest.approx(150.0) and len(series.fields) == 2
+    first = series.frames[0] if axes == "TYX" else series.frames[0].vertices
+    radius = np.linalg.norm(first - first.mean(axis=0), axis=1).mean()
+    assert radius == pytest.approx((12 if axes == "TYX" else 6) * PIXEL, abs=0.6 * PIXEL)
