@@ -195,7 +195,15 @@ def test_border_touching_object_is_warned_about(tmp_path):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         movie_frames(tmp_path / "edge.tif")
-    assert any("touches the image border" in str(w.message) for w in caught)
+    assert any(str(w.message).startswith("frame 0: mask: the object touches the image border") for w in caught)
+    # One mask or stack on its own, the same; an object inside the image says nothing.
+    with pytest.warns(UserWarning, match="mask: the object touches the image border"):
+        mm.boundary_from_mask(disc(shape, (30, 5), 12))
+    with pytest.warns(UserWarning, match="volume: the object touches the image border"):
+        mm.surface_from_mask(np.ones((8, 8, 8), dtype=bool))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        mm.boundary_from_mask(disc(shape, (30, 30), 12))
 
 
 def test_cli_series_from_a_movie(tmp_path):

@@ -71,11 +71,7 @@ def _object(frame: np.ndarray, objects: str, label, previous, t: int) -> np.ndar
         warnings.warn(f"{name}: the object is {count} separate parts ({', '.join(map(str, sorted(sizes)[::-1][:4]))}"
                       f" pixels); the largest is kept", UserWarning, stacklevel=4)
         chosen = parts == 1 + int(np.argmax(sizes))
-    edges = [np.take(chosen, i, axis=a) for a in range(chosen.ndim) for i in (0, -1)]
-    if any(edge.any() for edge in edges):
-        warnings.warn(f"{name}: the object touches the image border; the boundary there is the image's edge, "
-                      f"not the tissue's", UserWarning, stacklevel=4)
-    return chosen
+    return chosen  # boundary_from_mask / surface_from_mask warn where it touches the border
 
 
 def movie_frames(movie, *, label=None, objects=None, smooth=None, edge_length=None, spacing=None,
@@ -140,11 +136,15 @@ def movie_frames(movie, *, label=None, objects=None, smooth=None, edge_length=No
     for t, frame in enumerate(data):
         mask = _object(np.asarray(frame), objects, label if t == 0 or objects != "follow" else None, previous, t)
         previous = mask
-        if len(spatial) == 2:
-            frames.append(boundary_from_mask(mask, used, smooth=smooth))
-        else:
-            frames.append(surface_from_mask(mask, used, smooth=0.0 if smooth is None else smooth,
-                                            edge_length=edge_length))
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            if len(spatial) == 2:
+                frames.append(boundary_from_mask(mask, used, smooth=smooth))
+            else:
+                frames.append(surface_from_mask(mask, used, smooth=0.0 if smooth is None else smooth,
+                                                edge_length=edge_length))
+        for caught_warning in caught:  # said of the frame (the border warning of the mask readers)
+            warnings.warn(f"frame {t}: {caught_warning.message}", caught_warning.category, stacklevel=3)
     return Movie(frames, image.frame_interval, used, used_unit)
 
 

@@ -8,6 +8,7 @@ use, so that a boundary made here is the one their own scripts would make.
 from __future__ import annotations
 
 import numbers
+import warnings
 
 import numpy as np
 import trimesh
@@ -52,6 +53,15 @@ def _object(mask, label, name: str, ndim: int = 2) -> np.ndarray:
     if not chosen.any():
         raise ValueError(f"label: no pixel of {name} has the value {label}")
     return chosen
+
+
+def _warn_at_border(pixels: np.ndarray, name: str) -> None:
+    """A warning where the object touches the image border: the boundary there is the image's
+    edge, not the tissue's."""
+    if pixels.size and any(np.take(pixels, i, axis=a).any() for a in range(pixels.ndim) for i in (0, -1)):
+        warnings.warn(f"{name}: the object touches the image border; the boundary there is the image's edge, "
+                      f"not the tissue's (image a wider field, or crop the analysis away from the edge)",
+                      UserWarning, stacklevel=3)
 
 
 def _require_one_object(pixels: np.ndarray, name: str) -> None:
@@ -169,6 +179,7 @@ def boundary_from_mask(mask, spacing=1.0, *, label=None, smooth=None) -> np.ndar
     default = smooth is None
     sigma = 0.0 if default else as_length(smooth, "smooth", 0.0, allow_zero=True)
     _require_one_object(pixels, "mask")
+    _warn_at_border(pixels, "mask")
     # One pixel of padding closes the contour of an object touching the border.
     pad = 1
     image = np.pad(pixels.astype(float), pad)
@@ -259,6 +270,7 @@ def surface_from_mask(volume, spacing=(1.0, 1.0, 1.0), *, label=None, smooth=0.0
         ``smooth=1`` brings it back within 0.2%.
     """
     voxels = _object(volume, label, "volume", ndim=3)
+    _warn_at_border(voxels, "volume")
     step = _spacing(spacing, 3)
     sigma = as_length(smooth, "smooth", 0.0, allow_zero=True)
     edge = as_length(edge_length, "edge_length", max(step))
