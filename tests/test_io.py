@@ -79,17 +79,31 @@ def test_3d_field_round_trips_with_its_faces(tmp_path):
     s2 = s1.copy().apply_scale(1.4)
     field = mm.map_surfaces(s1, s2, "normal")
     mm.write_field(tmp_path / "f.csv", field)
+    # One table of vectors, as pandas.read_csv reads it; the faces in a file of their own beside.
     text = (tmp_path / "f.csv").read_text().splitlines()
-    assert text[0] == "start_x,start_y,start_z,end_x,end_y,end_z,valid,method"
-    assert text[len(field) + 1] == "face_a,face_b,face_c" and len(text) == len(field) + 2 + len(field.faces)
+    assert text[0] == "start_x,start_y,start_z,end_x,end_y,end_z,valid,method" and len(text) == len(field) + 1
+    assert all(len(line.split(",")) == 8 for line in text)
+    faces = (tmp_path / "f.faces.csv").read_text().splitlines()
+    assert faces[0] == "face_a,face_b,face_c" and len(faces) == len(field.faces) + 1
     back = mm.read_field(tmp_path / "f.csv")
     assert np.array_equal(back.starts, field.starts) and np.array_equal(back.ends, field.ends)
     assert np.array_equal(back.faces, field.faces)
     assert mm.quality(back, s1, s2) == mm.quality(field, s1, s2)
+    # The faces as a second table after the vectors (as files used to hold them) read the same.
+    (tmp_path / "one.csv").write_text("\n".join(text + faces) + "\n")
+    assert np.array_equal(mm.read_field(tmp_path / "one.csv").faces, field.faces)
     # Faces must index the vectors, and a 2D field has none.
-    (tmp_path / "bad.csv").write_text("\n".join(text[: len(field) + 2] + ["0,1,99999"]) + "\n")
+    (tmp_path / "bad.csv").write_text("\n".join(text + faces[:1] + ["0,1,99999"]) + "\n")
     with pytest.raises(ValueError, match="bad.csv: faces: vertex index 99999"):
         mm.read_field(tmp_path / "bad.csv")
+    (tmp_path / "g.csv").write_text("\n".join(text) + "\n")
+    (tmp_path / "g.faces.csv").write_text("face_a,face_b,face_c\n0,1\n")
+    with pytest.raises(ValueError, match="g.faces.csv: line 2: expected three vector indices"):
+        mm.read_field(tmp_path / "g.csv")
+    # To an open file the vectors alone, said so.
+    with open(tmp_path / "stream.csv", "w") as handle, pytest.warns(UserWarning, match="faces of a 3D field"):
+        mm.write_field(handle, field)
+    assert mm.read_field(tmp_path / "stream.csv").faces is None
     (tmp_path / "flat.csv").write_text(
         "start_x,start_y,end_x,end_y,valid,method\n0,0,1,1,1,normal\nface_a,face_b,face_c\n0,0,0\n"
     )

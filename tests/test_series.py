@@ -31,11 +31,12 @@ def test_spheres_and_writing(tmp_path):
     assert np.abs(np.linalg.norm(series.trajectories[-1], axis=1) - 1.4).max() < 2e-3  # faceted spheres
     assert series.stretch(1).mean() == pytest.approx((1.4 / 1.2) ** 2, rel=1e-2)
     paths = series.write(tmp_path / "out", figures=False)
-    assert [p.split("/")[-1] for p in paths] == ["field_00.csv", "field_01.csv", "trajectories.csv", "quality.csv",
+    assert [p.split("/")[-1] for p in paths] == ["field_00.csv", "field_00.faces.csv", "field_01.csv",
+                                                 "field_01.faces.csv", "trajectories.csv", "quality.csv",
                                                  "points.csv", "stretch.csv", "normal_speed.csv"]
-    back = mm.read_field(paths[1])
+    back = mm.read_field(paths[2])
     assert back.faces is not None and np.allclose(back.vectors, series.fields[1].vectors)
-    table = np.loadtxt(paths[2], delimiter=",", skiprows=1)
+    table = np.loadtxt(tmp_path / "out" / "trajectories.csv", delimiter=",", skiprows=1)
     assert table.shape == (3 * len(frames[0].vertices), 5)
     assert (tmp_path / "out" / "quality.csv").read_text().splitlines()[0].startswith("step,qm1,qm2,qm,folds")
 

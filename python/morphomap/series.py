@@ -16,7 +16,7 @@ from ._progress import progress_over
 from ._validate import as_length
 from .carry import IndexedCurve, carry_curve, carry_surface
 from .curves import normals
-from .io import write_field
+from .io.csv_files import write_field_csv
 from .io.atomic import atomic_text
 from .mapping import map_curves
 from .movie import Movie, describe_motion, is_movie_path, movie_frames, register_frames
@@ -133,7 +133,7 @@ class Series:
     def write(self, folder, *, figures=True) -> list:
         """Write into ``folder`` (created) and return the paths:
 
-        - ``field_KK.csv`` per step;
+        - ``field_KK.csv`` per step (3D: with ``field_KK.faces.csv``);
         - ``trajectories.csv`` (frame, point, coordinates; NaN before a point's birth and once lost)
           and ``points.csv`` (point, the frame it was born in);
         - ``quality.csv``, one row per step;
@@ -152,8 +152,7 @@ class Series:
         paths = []
         for k, field in enumerate(self.fields):
             path = os.path.join(folder, f"field_{k:02d}.csv")
-            write_field(path, field)
-            paths.append(path)
+            paths.extend(write_field_csv(path, field))
         axes = "xyz"[: self.dim]
         path = os.path.join(folder, "trajectories.csv")
         with atomic_text(path) as handle:

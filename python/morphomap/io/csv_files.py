@@ -2,9 +2,11 @@
 
 Curve files hold one point per row, ``x,y``, with an optional header row (``x,y``). Field files have
 the header ``start_x,start_y,end_x,end_y,valid,method`` (``start_z`` and ``end_z`` after the ``y``
-columns of a 3D field); rows without a target hold ``nan`` and ``valid`` 0. A 3D field's faces (the
-triangles of its start points, which its quality measures need) follow as a second table, headed
-``face_a,face_b,face_c``, of row indices into the vectors.
+columns of a 3D field); rows without a target hold ``nan`` and ``valid`` 0: one table, as
+``pandas.read_csv`` and spreadsheets read it. A 3D field's faces (the triangles of its start
+points, which its quality measures need) go into a second file beside it, ``NAME.faces.csv``
+(:func:`faces_path`), headed ``face_a,face_b,face_c``, of row indices into the vectors. Files that
+hold the faces as a second table after the vectors, in that header, are read too.
 
 Blank lines and lines starting with ``#`` are skipped. Values are separated by commas; a file
 without commas may separate them by tabs or spaces instead. Numbers are written with ``repr`` so
@@ -16,6 +18,7 @@ from __future__ import annotations
 import contextlib
 import math
 import os
+import warnings
 
 import numpy as np
 
@@ -123,14 +126,23 @@ def write_curve(path, points, *, header=True) -> None:
             handle.write(f"{x!r},{y!r}\n")
 
 
-def write_field_csv(path, field: DisplacementField) -> None:
+def faces_path(path) -> str:
+    """Where a 3D field's faces go beside its CSV file: ``NAME.faces.csv`` for ``NAME.csv``."""
+    name = os.fspath(path)
+    stem = name[:-4] if name.lower().endswith(".csv") else name
+    return stem + ".faces.csv"
+
+
+def write_field_csv(path, field: DisplacementField) -> list:
     """Write a displacement field as CSV: ``start_x,start_y,end_x,end_y,valid,method`` per vector
-    (:func:`morphomap.write_field` picks this writer for ``.csv`` and open files).
+    (:func:`morphomap.write_field` picks this writer for ``.csv`` and open files), and return the
+    paths written.
 
     Missing coordinates are written as ``nan``; ``valid`` is 1 or 0. 3D fields get ``start_z`` and
-    ``end_z`` columns, and their faces follow as a second table (``face_a,face_b,face_c``), so that
-    :func:`read_field` and :func:`morphomap.quality` round-trip. ``path``: a file name or an open
-    text file; a file name is written atomically.
+    ``end_z`` columns, and their faces go into ``NAME.faces.csv`` beside (:func:`faces_path`), so
+    that :func:`read_field` and :func:`morphomap.quality` round-trip. ``path``: a file name (written
+    atomically, with its faces file) or an open text file, which gets the vectors alone (a
+    ``UserWarning`` says where the faces of a 3D field did not go).
     """
     if not isinstance(field, DisplacementField):
         raise TypeError(f"field: expected a DisplacementField, got {type(field).__name__}")
@@ -142,20 +154,38 @@ def write_field_csv(path, field: DisplacementField) -> None:
         ):
             values = ",".join(repr(float(v)) for v in (*start, *end))
             handle.write(f"{values},{int(valid)},{method}\n")
+    if hasattr(path, "write"):
         if field.faces is not None:
+            warnings.warn("field: the faces of a 3D field are not written to an open file (a table of their own "
+                          "would follow the vectors); write to a .csv file to get NAME.faces.csv beside it",
+                          UserWarning, stacklevel=3)
+        return []
+    written = [os.fspath(path)]
+    if field.faces is not None:
+        with atomic_text(faces_path(path)) as handle:
             handle.write(",".join(_FACES) + "\n")
-            for a, b, c in field.faces.tolist():
-                handle.write(f"{a},{b},{c}\n")
+            handle.writelines(f"{a},{b},{c}\n" for a, b, c in field.faces.tolist())
+        written.append(faces_path(path))
+    return written
 
 
 def read_field(path) -> DisplacementField:
-    """Read a displacement field written by :func:`write_field_csv`.
+    """Read a displacement field written by :func:`write_field_csv`, with the faces in
+    ``NAME.faces.csv`` beside a 3D one where that file exists.
 
     The header is required; columns may come in any order. ``valid`` is recomputed from the
     coordinates (a row is valid when none of them is NaN), so the column is only checked.
     """
     name = os.fspath(path)
     rows = list(_rows(path))
+    beside, face_source = faces_path(name), name
+    if rows and "start_z" in [cell.lower() for cell in rows[0][1]] and os.path.isfile(beside):
+        face_file = list(_rows(beside))
+        if not face_file or [cell.lower() for cell in face_file[0][1]] != list(_FACES):
+            raise ValueError(f"{beside}: expected the header {','.join(_FACES)}")
+        if any([c.lower() for c in cells] == list(_FACES) for _, cells in rows[1:]):
+            raise ValueError(f"{name}: holds its faces itself, and {beside} holds faces too: remove one")
+        rows, face_source = rows + face_file, beside
     if not rows:
         raise ValueError(f"{name}: empty file, expected the header {','.join(_FIELD_2D)}")
     number, header = rows[0]
@@ -193,7 +223,7 @@ def read_field(path) -> DisplacementField:
         faces = np.empty((len(face_rows), 3), dtype=np.int64)
         for i, (number, cells) in enumerate(face_rows):
             if len(cells) != 3 or not all(cell.lstrip("-").isdigit() for cell in cells):
-                raise ValueError(f"{name}: line {number}: expected three vector indices face_a,face_b,face_c")
+                raise ValueError(f"{face_source}: line {number}: expected three vector indices face_a,face_b,face_c")
             faces[i] = [int(cell) for cell in cells]
     try:
         return DisplacementField(values[:, :dim], values[:, dim:], np.asarray(methods, dtype=str).reshape(-1), faces)

@@ -51,7 +51,7 @@ def _series(write):
 
 #: Suffix -> Format: every file morphomap writes fields into.
 FORMATS = {
-    ".csv": Format("CSV table of start and end points (3D: and the faces)",
+    ".csv": Format("CSV table of start and end points (3D: the faces in NAME.faces.csv beside)",
                    field=lambda path, field, dt: write_field_csv(path, field)),
     ".txt": Format("COMSOL interpolation table (spreadsheet format; velocity columns with dt)",
                    field=_comsol_field, interior=_comsol_interior),
