@@ -32,8 +32,13 @@ def test_spheres_and_writing(tmp_path):
     assert series.stretch(1).mean() == pytest.approx((1.4 / 1.2) ** 2, rel=1e-2)
     paths = series.write(tmp_path / "out", figures=False)
     assert [p.split("/")[-1] for p in paths] == ["field_00.csv", "field_00.faces.csv", "field_01.csv",
-                                                 "field_01.faces.csv", "trajectories.csv", "quality.csv",
+                                                 "field_01.faces.csv", "frame_00.ply", "frame_01.ply",
+                                                 "frame_02.ply", "trajectories.csv", "quality.csv",
                                                  "points.csv", "stretch.csv", "normal_speed.csv"]
+    for t, frame in enumerate(series.frames):
+        surface = mm.read_surface(tmp_path / "out" / f"frame_{t:02d}.ply")
+        np.testing.assert_array_equal(surface.vertices, frame.vertices)
+        np.testing.assert_array_equal(surface.faces, frame.faces)
     back = mm.read_field(paths[2])
     assert back.faces is not None and np.allclose(back.vectors, series.fields[1].vectors)
     table = np.loadtxt(tmp_path / "out" / "trajectories.csv", delimiter=",", skiprows=1)

@@ -17,6 +17,7 @@ from ._validate import as_length
 from .carry import IndexedCurve, carry_curve, carry_surface
 from .curves import normals
 from .io.csv_files import write_field_csv
+from .io.meshes import write_surface
 from .io.atomic import atomic_text
 from .mapping import map_curves
 from .movie import Movie, describe_motion, is_movie_path, movie_frames, register_frames
@@ -133,7 +134,8 @@ class Series:
     def write(self, folder, *, figures=True) -> list:
         """Write into ``folder`` (created) and return the paths:
 
-        - ``field_KK.csv`` per step (3D: with ``field_KK.faces.csv``);
+        - ``field_KK.csv`` per step (3D: with ``field_KK.faces.csv``), and in 3D ``frame_TT.ply``
+          per frame (the surfaces, as mapped);
         - ``trajectories.csv`` (frame, point, coordinates; NaN before a point's birth and once lost)
           and ``points.csv`` (point, the frame it was born in);
         - ``quality.csv``, one row per step;
@@ -153,6 +155,11 @@ class Series:
         for k, field in enumerate(self.fields):
             path = os.path.join(folder, f"field_{k:02d}.csv")
             paths.extend(write_field_csv(path, field))
+        if self.dim == 3:  # the frames as surfaces, for ParaView and MeshLab beside the fields
+            for t, frame in enumerate(self.frames):
+                path = os.path.join(folder, f"frame_{t:02d}.ply")
+                write_surface(path, frame)
+                paths.append(path)
         axes = "xyz"[: self.dim]
         path = os.path.join(folder, "trajectories.csv")
         with atomic_text(path) as handle:
