@@ -103,8 +103,8 @@ struct Level {
 //   M of them in all, as the DP's cost grows with the square of the samples;
 // - the uniform map's position alpha * s of each of the level's starts, where the stretch term
 //   is zero: a start a hair from a piece's end on a long target edge (the limb's flank, where the
-//   curves cross on it) otherwise lands a whole sample step away; limb 300 -> 301 h closed went
-//   from QM 14 to 0.0013 (bench/README.md, "Real 2D outlines").
+//   curves cross on it) otherwise lands a whole sample step away; with them optimal's QM on the
+//   limb outlines stays within 1.83 times normal mapping's (bench/README.md, "Real 2D outlines").
 std::vector<double> sample_arcs(const Problem& p, Index samples, const std::vector<Index>& rows) {
   const Index even = p.uneven_target ? (samples + 1) / 2 : samples;
   std::vector<double> t(even + 1);
