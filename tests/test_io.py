@@ -92,6 +92,9 @@ def test_3d_field_round_trips_with_its_faces(tmp_path):
     # The faces as a second table after the vectors (as files used to hold them) read the same.
     (tmp_path / "one.csv").write_text("\n".join(text + faces) + "\n")
     assert np.array_equal(mm.read_field(tmp_path / "one.csv").faces, field.faces)
+    (tmp_path / "one.faces.csv").write_text("\n".join(faces) + "\n")
+    with pytest.raises(ValueError, match="holds its faces itself, and .*one.faces.csv holds faces too"):
+        mm.read_field(tmp_path / "one.csv")
     # Faces must index the vectors, and a 2D field has none.
     (tmp_path / "bad.csv").write_text("\n".join(text + faces[:1] + ["0,1,99999"]) + "\n")
     with pytest.raises(ValueError, match="bad.csv: faces: vertex index 99999"):

@@ -43,16 +43,15 @@ class Movie(NamedTuple):
 def _object(frame: np.ndarray, objects: str, label, previous, t: int) -> np.ndarray:
     """The mask of the object in one frame (a mask or a label image)."""
     name = f"frame {t}"
-    if objects == "union":
-        chosen = frame != 0 if label is None else frame == label
+    if label is not None and (objects != "follow" or previous is None):
+        chosen = frame == label  # linked labels, or where "follow" starts
+    elif objects == "union":
+        chosen = frame != 0
     elif objects == "largest" or previous is None:
-        if label is not None:
-            chosen = frame == label
-        else:
-            values, counts = np.unique(frame[frame != 0], return_counts=True)
-            if len(values) == 0:
-                raise ValueError(f"{name}: has no object (every pixel is 0)")
-            chosen = frame == values[np.argmax(counts)]
+        values, counts = np.unique(frame[frame != 0], return_counts=True)
+        if len(values) == 0:
+            raise ValueError(f"{name}: has no object (every pixel is 0)")
+        chosen = frame == values[np.argmax(counts)]
     else:  # follow: the label overlapping the previous frame's object most
         values, counts = np.unique(frame[previous & (frame != 0)], return_counts=True)
         if len(values) == 0:
@@ -134,7 +133,7 @@ def movie_frames(movie, *, label=None, objects=None, smooth=None, edge_length=No
         used, used_unit = (1.0,) * len(spatial), None
     frames, previous = [], None
     for t, frame in enumerate(data):
-        mask = _object(np.asarray(frame), objects, label if t == 0 or objects != "follow" else None, previous, t)
+        mask = _object(np.asarray(frame), objects, label, previous, t)
         previous = mask
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")

@@ -178,14 +178,6 @@ def read_field(path) -> DisplacementField:
     """
     name = os.fspath(path)
     rows = list(_rows(path))
-    beside, face_source = faces_path(name), name
-    if rows and "start_z" in [cell.lower() for cell in rows[0][1]] and os.path.isfile(beside):
-        face_file = list(_rows(beside))
-        if not face_file or [cell.lower() for cell in face_file[0][1]] != list(_FACES):
-            raise ValueError(f"{beside}: expected the header {','.join(_FACES)}")
-        if any([c.lower() for c in cells] == list(_FACES) for _, cells in rows[1:]):
-            raise ValueError(f"{name}: holds its faces itself, and {beside} holds faces too: remove one")
-        rows, face_source = rows + face_file, beside
     if not rows:
         raise ValueError(f"{name}: empty file, expected the header {','.join(_FIELD_2D)}")
     number, header = rows[0]
@@ -197,9 +189,17 @@ def read_field(path) -> DisplacementField:
     index = {column: header.index(column) for column in wanted}
     coordinates = [column for column in wanted if column not in ("valid", "method")]
     dim = len(coordinates) // 2
-    face_rows = []
+    face_rows, face_source = [], name
     split = next((k for k, (_, cells) in enumerate(rows) if [c.lower() for c in cells] == list(_FACES)), None)
-    if split is not None:
+    beside = faces_path(name)
+    if dim == 3 and os.path.isfile(beside):
+        if split is not None:
+            raise ValueError(f"{name}: holds its faces itself, and {beside} holds faces too: remove one")
+        face_file = list(_rows(beside))
+        if not face_file or [cell.lower() for cell in face_file[0][1]] != list(_FACES):
+            raise ValueError(f"{beside}: expected the header {','.join(_FACES)}")
+        split, face_rows, face_source = len(rows), face_file[1:], beside
+    elif split is not None:
         if dim != 3:
             raise ValueError(f"{name}: line {rows[split][0]}: a 2D field has no faces")
         rows, face_rows = rows[:split], rows[split + 1 :]
