@@ -12,6 +12,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -290,6 +291,72 @@ void require_options(const ExtendOptions& options) {
   detail::require_mesh_size(options.mesh_size);
 }
 
+// A triangle with its three corners on C1 moves with the boundary field alone: where the field
+// brings the three into line or past it (the corners where a limb outline meets its flank
+// segment) the triangle flattens or turns over, and neither substeps nor untangling can help.
+// Splitting its longest inner edge at the midpoint (both triangles on that edge become two) gives
+// every part a free corner, the 2D form of volume_mesh's split_chords. Passes until none is left,
+// since a triangle beside one just split waits for the next (bench/README.md "Interior motion
+// through a series": limb outlines 10 h apart). Only the vertices and triangles are kept up to date.
+void split_boundary_triangles(detail::RegionMesh& mesh) {
+  std::vector<char> on_boundary(mesh.on_boundary.begin(), mesh.on_boundary.end());
+  for (bool again = true; again;) {
+    again = false;
+    const Index count = mesh.triangles.rows();
+    std::map<std::pair<Index, Index>, std::vector<Index>> sides;  // an edge's triangles
+    for (Index t = 0; t < count; ++t) {
+      for (int i = 0; i < 3; ++i) {
+        const Index a = mesh.triangles(t, i), b = mesh.triangles(t, (i + 1) % 3);
+        sides[{std::min(a, b), std::max(a, b)}].push_back(t);
+      }
+    }
+    std::vector<char> taken(count, 0);
+    std::vector<Eigen::Matrix<Index, 1, 3>> added;
+    std::vector<Eigen::RowVector2d> midpoints;
+    for (Index t = 0; t < count; ++t) {
+      if (taken[t] || !on_boundary[mesh.triangles(t, 0)] || !on_boundary[mesh.triangles(t, 1)] ||
+          !on_boundary[mesh.triangles(t, 2)]) {
+        continue;
+      }
+      std::pair<Index, Index> longest(-1, -1);
+      double length = -1.0;
+      for (int i = 0; i < 3; ++i) {
+        const Index a = mesh.triangles(t, i), b = mesh.triangles(t, (i + 1) % 3);
+        const auto& around = sides[{std::min(a, b), std::max(a, b)}];
+        const double l = (mesh.vertices.row(a) - mesh.vertices.row(b)).norm();
+        if (around.size() == 2 && !taken[around[0]] && !taken[around[1]] && l > length) {
+          length = l;
+          longest = {a, b};
+        }
+      }
+      if (longest.first < 0) continue;
+      const Index m = mesh.vertices.rows() + static_cast<Index>(midpoints.size());
+      midpoints.push_back(0.5 * (mesh.vertices.row(longest.first) + mesh.vertices.row(longest.second)));
+      // Each triangle on the edge becomes two, the midpoint in place of one end and then the
+      // other: the orientation stays.
+      for (const Index s : sides[{std::min(longest.first, longest.second), std::max(longest.first, longest.second)}]) {
+        taken[s] = 1;
+        Eigen::Matrix<Index, 1, 3> second = mesh.triangles.row(s);
+        for (int i = 0; i < 3; ++i) {
+          if (mesh.triangles(s, i) == longest.first) mesh.triangles(s, i) = m;
+          if (second(i) == longest.second) second(i) = m;
+        }
+        added.push_back(second);
+      }
+    }
+    if (midpoints.empty()) break;
+    again = true;
+    const Index vertices = mesh.vertices.rows();
+    mesh.vertices.conservativeResize(vertices + static_cast<Index>(midpoints.size()), Eigen::NoChange);
+    for (std::size_t k = 0; k < midpoints.size(); ++k) {
+      mesh.vertices.row(vertices + static_cast<Index>(k)) = midpoints[k];
+    }
+    on_boundary.resize(static_cast<std::size_t>(mesh.vertices.rows()), 0);
+    mesh.triangles.conservativeResize(count + static_cast<Index>(added.size()), Eigen::NoChange);
+    for (std::size_t k = 0; k < added.size(); ++k) mesh.triangles.row(count + static_cast<Index>(k)) = added[k];
+  }
+}
+
 // The mesh size for Mesh_3: the one asked for, else the start triangles' mean edge (checking that
 // every corner has a start point, as the surface to mesh).
 double default_size(const DisplacementField3& field, const ExtendOptions& options) {
@@ -346,6 +413,7 @@ InteriorField2 extend_field(const DisplacementField2& field, const Points2Ref& s
         // (require_simple_curve has checked the curve: only its repeats are dropped here.)
         detail::RegionMesh mesh =
             detail::mesh_region({detail::drop_repeats(source, true, "source")}, options.mesh_size);
+        split_boundary_triangles(mesh);
         out.points = std::move(mesh.vertices);
         out.cells = std::move(mesh.triangles);
       },
