@@ -25,6 +25,7 @@ from .diffusion3d import ShellDiffusionSolution, solve_diffusion_3d
 from .extend import InteriorField, extend_field
 from .field import DisplacementField
 from .mapping import map_curves
+from .moving_mesh import MovingMesh, extend_series
 from .prepared import PreparedCurve, PreparedSurface
 from .quality import CurveQuality, SurfaceQuality, quality
 from .queries import CurveHits, CurveIndex, closest_points, line_intersections
@@ -64,6 +65,7 @@ __all__ = [
     "InteriorField",
     "InvalidInput",
     "Job",
+    "MovingMesh",
     "Series",
     "ShellDiffusionSolution",
     "Similarity",
@@ -81,6 +83,7 @@ __all__ = [
     "crossing_pairs",
     "curve_intersections",
     "extend_field",
+    "extend_series",
     "is_self_intersecting",
     "line_intersections",
     "load_example",

@@ -21,6 +21,7 @@ from .io.meshes import write_surface
 from .io.atomic import atomic_text
 from .mapping import map_curves
 from .movie import Movie, describe_motion, is_movie_path, movie_frames, register_frames
+from .moving_mesh import MeshStep, MovingMesh, extend_series
 from .prepared import PreparedCurve, PreparedSurface, as_surface
 from .quality import quality
 from .reseed import reseed_curve, reseed_surface
@@ -41,6 +42,7 @@ class StepQuality:
     misses: int
     seconds: float
     methods: dict = dataclass_field(default_factory=dict)
+    mesh: MeshStep | None = None  # the moving solver mesh over the step (Series.extend)
 
 
 class Series:
@@ -84,12 +86,16 @@ class Series:
         With ``register``: the rigid motion (homogeneous matrix) that took each frame as given onto
         the frame as mapped, the identity for frame 0 (:func:`morphomap.movie.register_frames`);
         None without.
+    interior : MovingMesh or None
+        After :meth:`extend` (or ``map_series(..., interior=...)``): a solver mesh of frame 0's
+        domain moved through the frames; None before.
     """
 
     def __init__(self, frames, fields, trajectories, quality, *, born=None, cells=None, stretches=None,
                  accumulated=None, normal_speed=None, accumulated_normal_speed=None, dt=1.0, motion=None):
         self.frames, self.fields, self.trajectories, self.quality = frames, fields, trajectories, quality
         self.motion = motion
+        self.interior = None
         self.born = np.zeros(trajectories.shape[1], dtype=np.int64) if born is None else born
         self.cells, self._stretches, self._accumulated = cells, stretches, accumulated
         self.normal_speed, self.accumulated_normal_speed, self.dt = normal_speed, accumulated_normal_speed, dt
@@ -118,6 +124,27 @@ class Series:
         points split passes its accumulated stretch on to its parts). NaN where a point was lost."""
         return self._accumulated[self._step(step)].copy()
 
+    def extend(self, mesh=None, *, method="harmonic", mesh_size=None, progress=None) -> MovingMesh:
+        """Carry one solver mesh of frame 0's domain through the frames (:func:`morphomap.extend_series`
+        on :attr:`fields`): each step's field extended inside on the mesh as moved so far, with no
+        inverted cell unasked. Sets :attr:`interior` and the mesh quality of every row of
+        :attr:`quality` (``mesh``), and returns the :class:`MovingMesh`.
+
+        Parameters
+        ----------
+        mesh : (points, cells), optional
+            The solver's mesh of frame 0's domain, in the frames' units; by default made by CGAL.
+        method, mesh_size : as :func:`morphomap.extend_field`.
+        progress : bool, optional
+            A progress bar counting the steps (the rule of :func:`map_series`).
+        """
+        moving = extend_series(self.fields, mesh, frames=self.frames, method=method, mesh_size=mesh_size,
+                               dt=self.dt, progress=progress)
+        self.interior = moving
+        for row, step in zip(self.quality, moving.quality):
+            row.mesh = step
+        return moving
+
     def plot_trajectories(self, ax=None, **options):
         """The followed points' paths coloured by time: :func:`morphomap.series_plot.plot_trajectories`."""
         return plot_trajectories(self, ax, **options)
@@ -144,6 +171,11 @@ class Series:
           growth maps;
         - with ``register``: ``motion.csv`` (frame, the matrix of :attr:`motion` row by row, and
           the translation and rotation in words);
+        - with :attr:`interior`: ``interior.xdmf`` (+ ``interior.h5``; dolfinx reads the mesh with
+          ``read_mesh()`` and step k at ``time=k * dt``) and ``interior.pvd`` (+ one ``.vtu`` per
+          step, for ParaView), and the mesh quality per step in ``quality.csv`` (inverted cells,
+          smallest area/volume ratio, smallest angle in degrees, boundary distance, substeps,
+          untangled);
         - with ``figures``: ``trajectories.png``, ``stretch.png`` and ``normal_speed.png`` (the
           accumulated maps at the last frame), ``series.gif``, and ``series.mp4`` when ffmpeg is
           installed.
@@ -170,12 +202,24 @@ class Series:
         paths.append(path)
         path = os.path.join(folder, "quality.csv")
         defects = "crossings" if self.dim == 2 else "folds"
+        mesh = ",inverted,min_jacobian,min_angle,boundary_distance,substeps,untangled" if self.interior else ""
         with atomic_text(path) as handle:
-            handle.write(f"step,qm1,qm2,qm,{defects},misses,seconds,methods\n")
+            handle.write(f"step,qm1,qm2,qm,{defects},misses,seconds,methods{mesh}\n")
             for q in self.quality:
                 methods = " ".join(f"{k}:{v}" for k, v in q.methods.items())
-                handle.write(f"{q.step},{q.qm1!r},{q.qm2!r},{q.qm!r},{q.defects},{q.misses},{q.seconds:.3f},{methods}\n")
+                handle.write(f"{q.step},{q.qm1!r},{q.qm2!r},{q.qm!r},{q.defects},{q.misses},{q.seconds:.3f},{methods}")
+                if mesh:
+                    m = q.mesh
+                    handle.write(f",{m.inverted},{m.min_jacobian!r},{m.min_angle!r},{m.boundary_distance!r},"
+                                 f"{m.substeps},{str(m.untangled).lower()}")
+                handle.write("\n")
         paths.append(path)
+        if self.interior is not None:
+            for name in ("interior.xdmf", "interior.pvd"):
+                self.interior.write(os.path.join(folder, name))
+            # With the files beside them: interior.h5, and one interior_KKKK.vtu per step.
+            paths.extend(sorted(os.path.join(folder, name) for name in os.listdir(folder)
+                                if name.startswith("interior.") or name.startswith("interior_")))
         path = os.path.join(folder, "points.csv")
         with atomic_text(path) as handle:
             handle.write("point,born\n")
@@ -221,7 +265,7 @@ class Series:
 
 
 def map_series(frames, method="auto", *, dt=None, reseed=2.0, register=None, label=None, objects=None,
-               progress=None, **options) -> Series:
+               interior=None, progress=None, **options) -> Series:
     """Map every consecutive pair of a time series and follow the points of the first frame.
 
     Parameters
@@ -257,6 +301,10 @@ def map_series(frames, method="auto", *, dt=None, reseed=2.0, register=None, lab
         frames as moved and :attr:`Series.motion` says by how much.
     label, objects : optional
         Only with a movie file: which object each frame gives (:func:`morphomap.movie.movie_frames`).
+    interior : True or (points, cells), optional
+        Also carry a solver mesh of frame 0's domain through the frames (:meth:`Series.extend`):
+        ``True`` for one made by CGAL, or the solver's own mesh. Then :attr:`Series.interior`
+        holds it and each row of :attr:`Series.quality` its mesh quality over the step.
     progress : bool, optional
         One progress bar (tqdm) on stderr counting the pairs; by default shown when stderr is a
         terminal and the call runs longer than 3 seconds, ``True``: at once, ``False``: never. The
@@ -292,6 +340,11 @@ def map_series(frames, method="auto", *, dt=None, reseed=2.0, register=None, lab
     if any(curves) and not all(curves):
         raise ValueError("frames: mix curves and surfaces; expected all of one kind")
     dt = as_length(dt, "dt", 1.0)
+    if interior is False:
+        interior = None
+    if not (interior is None or interior is True or (isinstance(interior, (tuple, list)) and len(interior) == 2)):
+        raise TypeError(f"interior: expected True (a mesh made by CGAL) or the solver's (points, cells) mesh of "
+                        f"frame 0, got {type(interior).__name__}")
     if reseed is not None:
         reseed = as_length(reseed, "reseed", 2.0)
         if reseed <= 1:
@@ -369,9 +422,12 @@ def map_series(frames, method="auto", *, dt=None, reseed=2.0, register=None, lab
     mean_table = np.full((len(fields), len(born)), np.nan)
     for k, (v, m) in enumerate(zip(speeds, mean_speeds)):
         speed_table[k, : len(v)], mean_table[k, : len(m)] = v, m
-    return Series(frames, fields, trajectories, table, born=born, cells=cells, stretches=stretches,
-                  accumulated=accumulated, normal_speed=speed_table, accumulated_normal_speed=mean_table, dt=dt,
-                  motion=motion)
+    series = Series(frames, fields, trajectories, table, born=born, cells=cells, stretches=stretches,
+                    accumulated=accumulated, normal_speed=speed_table, accumulated_normal_speed=mean_table, dt=dt,
+                    motion=motion)
+    if interior is not None:
+        series.extend(None if interior is True else interior, progress=progress)
+    return series
 
 
 def _simple_frames(frames, closed: bool) -> list:

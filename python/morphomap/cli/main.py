@@ -202,6 +202,12 @@ def main(argv=None) -> int:
         help="new points are born where neighbouring followed points get more than F times the "
         "first frame's spacing apart (default 2; 'none': follow only the first frame's points)",
     )
+    series.add_argument("--interior", action="store_true",
+                        help="also carry a mesh of the first frame's domain through the frames (the solver's "
+                        "mesh motion, no cell inverted): interior.xdmf for dolfinx, interior.pvd for ParaView, and "
+                        "the mesh quality per step in quality.csv")
+    series.add_argument("--mesh", metavar="MESH", help="with --interior: the solver's own mesh of the first frame's "
+                        "domain (.xdmf, .vtu, .msh, ...; default: one made by CGAL)")
     series.add_argument("--no-progress", action="store_true", help="no progress bar (default: one on a terminal)")
     series.set_defaults(run=_command("series", "run", series))
     batch = commands.add_parser(

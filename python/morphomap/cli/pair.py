@@ -6,7 +6,6 @@ import os
 import sys
 import warnings
 
-import meshio
 import numpy as np
 
 import morphomap
@@ -18,7 +17,7 @@ from ..io.formats import write_field, write_interior, writer
 from ..mapping import map_curves
 from ..quality import quality
 from ..surfaces import map_surfaces
-from .frames import read_frame
+from .frames import read_frame, read_solver_mesh
 
 
 def _read_and_map(args, parser):
@@ -109,16 +108,7 @@ def run_extend(args, parser) -> int:
     except ValueError as error:
         parser.error(f"-o {args.output}: {error}")
     _, _, _, field, q = _read_and_map(args, parser)
-    mesh = None
-    if args.mesh:
-        try:
-            solver_mesh = meshio.read(args.mesh)
-        except (OSError, ValueError, KeyError, meshio.ReadError) as error:
-            parser.error(f"cannot read the mesh {args.mesh}: {error}")
-        kind = "triangle" if field.dim == 2 else "tetra"
-        if kind not in solver_mesh.cells_dict:
-            parser.error(f"{args.mesh}: has no {kind} cells (found: {', '.join(solver_mesh.cells_dict) or 'none'})")
-        mesh = (solver_mesh.points[:, : field.dim], solver_mesh.cells_dict[kind])
+    mesh = read_solver_mesh(args.mesh, field.dim, parser) if args.mesh else None
     try:
         interior = extend_field(field, mesh=mesh, mesh_size=args.extend_mesh_size, method=args.extension,
                                 poisson_ratio=args.poisson_ratio, substeps=args.substeps, untangle=args.untangle)

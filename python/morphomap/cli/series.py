@@ -7,7 +7,7 @@ import sys
 from .._core import GeometryError, InvalidInput
 from ..movie import describe_motion, movie_frames
 from ..series import map_series
-from .frames import read_frame
+from .frames import read_frame, read_solver_mesh
 
 
 def _movie(path: str, args):
@@ -39,9 +39,16 @@ def run(args, parser) -> int:
             parser.error(f"cannot read {path}: {error.strerror or error}")
         except (ValueError, TypeError) as error:
             parser.error(f"{path}: {error}")
+    if args.mesh and not args.interior:
+        parser.error("--mesh: only with --interior")
+    interior = None
+    if args.interior:
+        first = frames.frames[0] if hasattr(frames, "frames") else frames[0]
+        dim = 2 if getattr(first, "ndim", 0) == 2 and first.shape[1] == 2 else 3
+        interior = read_solver_mesh(args.mesh, dim, parser) if args.mesh else True
     try:
         series = map_series(frames, args.method, dt=args.dt, reseed=args.reseed, register=args.register,
-                            progress=False if args.no_progress else None)
+                            interior=interior, progress=False if args.no_progress else None)
     except (ValueError, TypeError, InvalidInput, GeometryError) as error:
         parser.error(str(error))
     if series.motion is not None:
@@ -53,7 +60,9 @@ def run(args, parser) -> int:
         parser.error(f"cannot write {error.filename}: {error.strerror or error}")
     for q in series.quality:
         kind = "crossings" if series.dim == 2 else "folds"
+        mesh = "" if q.mesh is None else (f"  mesh: {q.mesh.inverted} inverted, smallest angle "
+                                          f"{q.mesh.min_angle:.3g} deg, {q.mesh.substeps} substeps")
         print(f"step {q.step}: QM1 {q.qm1:.4g}  QM2 {q.qm2:.4g}  QM {q.qm:.4g}  {kind} {q.defects}  misses {q.misses}  "
-              f"{q.seconds:.2f} s", file=sys.stderr)
+              f"{q.seconds:.2f} s{mesh}", file=sys.stderr)
     print(f"{series!r}; {len(written)} files written to {args.out}", file=sys.stderr)
     return 0

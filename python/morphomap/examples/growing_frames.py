@@ -3,10 +3,10 @@
     python -m morphomap.examples.growing_frames OUT [3d]
 
 Frames 0..4 of a growing outline with a bud (closed curves; with ``3d`` closed surfaces), each
-consecutive pair mapped (``map_curves`` / ``map_surfaces``, the default method), and the boundary
-displacement extended into the domain on
-one mesh that moves with it: frame 0's domain meshed once, the mesh of frame k + 1 the mesh of
-frame k moved by the interior field (``extend_field``, which leaves no cell inverted). Writes
+consecutive pair mapped (``map_series``, the default method), and the boundary displacement
+extended into the domain on one mesh that moves with it (``Series.extend``): frame 0's domain
+meshed once, the mesh of frame k + 1 the mesh of frame k moved by the interior field, which
+leaves no cell inverted, its boundary nodes on frame k + 1. Writes
 ``OUT/motion.xdmf`` (+ ``.h5``): the mesh (grid ``mesh``, frame 0) and, per step k at time k·dt,
 the nodes of frame k and the displacement that takes them to frame k + 1.
 :mod:`morphomap.examples.growing_domain_fenicsx` solves the paper's Eq. 2 on it in dolfinx.
@@ -21,7 +21,6 @@ import numpy as np
 import trimesh
 
 import morphomap as mm
-from morphomap.io import write_interior_series
 
 
 def frames(count: int = 5, points: int = 400):
@@ -54,18 +53,13 @@ def prepare(folder, count: int = 5, mesh_size: float = None, dt: float = 1.0, di
     """
     if dim not in (2, 3):
         raise ValueError(f"dim: expected 2 or 3, got {dim!r}")
-    shapes, mapping = (frames(count), mm.map_curves) if dim == 2 else (surfaces(count), mm.map_surfaces)
+    shapes = frames(count) if dim == 2 else surfaces(count)
     mesh_size = (0.08 if dim == 2 else 0.15) if mesh_size is None else mesh_size
-    interiors = []
-    mesh = None
-    for k in range(count - 1):
-        field = mapping(shapes[k], shapes[k + 1])
-        interior = mm.extend_field(field, mesh=mesh, mesh_size=mesh_size)
-        interiors.append(interior)
-        mesh = (interior.points + interior.displacement, interior.cells)
+    series = mm.map_series(shapes, dt=dt, reseed=None)
+    moving = series.extend(mesh_size=mesh_size)
     os.makedirs(folder, exist_ok=True)
-    write_interior_series(os.path.join(folder, "motion.xdmf"), interiors, [k * dt for k in range(count - 1)])
-    return interiors
+    moving.write(os.path.join(folder, "motion.xdmf"))
+    return moving.steps
 
 
 def main(argv=None):
