@@ -20,7 +20,6 @@ from __future__ import annotations
 from typing import NamedTuple, Optional
 
 import numpy as np
-from matplotlib.colors import LogNorm, Normalize, TwoSlopeNorm
 
 from ._validate import as_flag
 from .field import METHOD_NAMES
@@ -84,7 +83,7 @@ class ColourScale(NamedTuple):
     """What :func:`colour_scale` returns: the norm, the colour map's name, and which ends of the
     colour bar get arrows (values beyond the scale: ``"neither"``, ``"min"``, ``"max"``, ``"both"``)."""
 
-    norm: Normalize
+    norm: object  # a matplotlib.colors.Normalize
     cmap: str
     extend: str
 
@@ -107,6 +106,10 @@ def colour_scale(values, scale: str = "robust", *, diverging: bool = False) -> C
     ValueError
         An unknown ``scale``, or ``"log"`` for values that are not all positive.
     """
+    # matplotlib here, not at the top: the command line names methods through this module
+    # without paying for matplotlib where no picture is drawn.
+    from matplotlib.colors import LogNorm, Normalize, TwoSlopeNorm
+
     if scale not in SCALES:
         raise ValueError(f"scale: expected one of {', '.join(map(repr, SCALES))}, got {scale!r}")
     values = np.asarray(values, dtype=float)
@@ -117,9 +120,7 @@ def colour_scale(values, scale: str = "robust", *, diverging: bool = False) -> C
         return ColourScale(Normalize(0.0, 1.0), SEQUENTIAL_MAP, "neither")
     smallest, largest = float(values.min()), float(values.max())
     low, high = (smallest, largest) if scale == "linear" else map(float, np.percentile(values, PERCENTILES))
-    if high <= low:  # (nearly) one value: the full range, else a band around it
-        low, high = smallest, largest
-    if high <= low:
+    if high <= low:  # one value (outliers aside, which still must not set the scale): a band around it
         low, high = (low / 2, high * 2) if scale == "log" else (low - 0.5 * abs(low or 1), high + 0.5 * abs(high or 1))
     extend = {(False, False): "neither", (True, False): "min", (False, True): "max", (True, True): "both"}[
         (smallest < low, largest > high)]
