@@ -14,14 +14,10 @@ from mpl_toolkits.mplot3d.art3d import Line3DCollection
 from ._validate import as_flag, as_points
 from .crossings import crossing_pairs
 from .field import DisplacementField
+from .figure_style import (C1_COLOUR, C2_COLOUR, CROSSING_COLOUR, MISS_COLOUR, VECTOR_COLOUR,  # noqa: F401
+                           colour_bar, colour_scale, orient_axes, resolve_y_down, unit_name)
 from .io.atomic import atomic_path
 from .prepared import as_surface
-
-C1_COLOUR = "tab:green"
-C2_COLOUR = "tab:blue"
-VECTOR_COLOUR = "red"
-CROSSING_COLOUR = "darkorange"
-MISS_COLOUR = "grey"
 
 
 def _headless() -> bool:
@@ -47,7 +43,7 @@ def _closed_line(points, closed):
     return np.vstack([points, points[:1]]) if closed and len(points) else points
 
 
-def plot_field(field, c1, c2, ax=None, *, closed=True, title=None, y_down=False):
+def plot_field(field, c1, c2, ax=None, *, closed=True, title=None, y_down=None, unit=None):
     """Draw a displacement field between two curves (2D) or surfaces (3D); returns the ``Axes``.
 
     3D fields are drawn by :func:`plot_field_3d` (``c1``, ``c2`` are then the surfaces); the rest
@@ -72,9 +68,13 @@ def plot_field(field, c1, c2, ax=None, *, closed=True, title=None, y_down=False)
     closed : bool
         Draw the curves closed.
     title : str, optional
-    y_down : bool
+    y_down : bool, optional
         Draw y growing downwards, the way an image looks: for curves from
-        :func:`morphomap.boundary_from_mask`, whose y is the image row.
+        :func:`morphomap.boundary_from_mask`, whose y is the image row (``morphomap map --plot``
+        does so for masks). None (the default): y-up, as curves carry no mark of an image.
+    unit : str, optional
+        The unit of the coordinates, for the axis labels (``"um"`` is written ``"µm"``); by
+        default ``"units"``.
 
     Artists added: two lines (C1, C2) and two collections (the vectors, their end points), plus one
     collection for crossing vectors and one for misses when there are any.
@@ -82,8 +82,9 @@ def plot_field(field, c1, c2, ax=None, *, closed=True, title=None, y_down=False)
     if not isinstance(field, DisplacementField):
         raise TypeError(f"field: expected a DisplacementField, got {type(field).__name__}")
     if field.dim == 3:
-        return plot_field_3d(field, c1, c2, ax=ax, title=title)
-    y_down = as_flag(y_down, "y_down")
+        return plot_field_3d(field, c1, c2, ax=ax, title=title, y_down=y_down, unit=unit)
+    y_down = resolve_y_down(y_down, False)
+    unit_name(unit)  # a bad unit refused before anything is drawn
     c1 = as_points(c1, "c1")
     c2 = as_points(c2, "c2")
     closed = as_flag(closed, "closed")
@@ -115,8 +116,7 @@ def plot_field(field, c1, c2, ax=None, *, closed=True, title=None, y_down=False)
                    label=f"no target ({int(missed.sum())})")
     ax.set_aspect("equal", adjustable="datalim")
     ax.autoscale_view()
-    if y_down:
-        ax.invert_yaxis()
+    orient_axes(ax, 2, y_down=y_down, unit=unit)
     ax.legend(loc="best", fontsize="small", framealpha=0.8)
     if title is not None:
         ax.set_title(title)
@@ -127,21 +127,26 @@ def plot_field(field, c1, c2, ax=None, *, closed=True, title=None, y_down=False)
 MAX_VECTORS_3D = 4000
 
 
-def plot_field_3d(field, s1, s2, ax=None, *, title=None):
+def plot_field_3d(field, s1, s2, ax=None, *, title=None, y_down=None, unit=None):
     """Draw a 3D displacement field between two surfaces; returns the matplotlib 3D ``Axes``.
 
     S1 is drawn in translucent green, S2 in translucent blue, the vectors as lines coloured by their
-    length (a colour bar gives the scale; at most :data:`MAX_VECTORS_3D` of them, evenly chosen, so
-    that the surfaces stay visible), start points without a target as grey ``x``. Equal aspect.
+    length (a colour bar gives the scale, robust: :func:`morphomap.figure_style.colour_scale`; at
+    most :data:`MAX_VECTORS_3D` of them, evenly chosen, so that the surfaces stay visible), start
+    points without a target as grey ``x``. Equal aspect.
 
     ``s1``, ``s2``: ``trimesh.Trimesh`` or ``(vertices, faces)`` pairs; ``ax``: a 3D axes
-    (``projection="3d"``), by default a new figure.
+    (``projection="3d"``), by default a new figure. ``y_down``: seen as the image's slices look
+    (x right, y down; for surfaces from :func:`morphomap.surface_from_mask`), by default not;
+    ``unit``: the coordinates' unit for the labels (default ``"units"``).
     """
     if not isinstance(field, DisplacementField):
         raise TypeError(f"field: expected a DisplacementField, got {type(field).__name__}")
     if field.dim != 3:
         raise ValueError(f"field: expected a 3D field, got {field.dim}D")
     surfaces = [as_surface(s1, "s1"), as_surface(s2, "s2")]
+    y_down = resolve_y_down(y_down, False)
+    unit_name(unit)  # a bad unit refused before anything is drawn
     if title is not None and not isinstance(title, str):
         raise TypeError(f"title: expected a string, got {type(title).__name__}")
     if ax is None:
@@ -154,11 +159,12 @@ def plot_field_3d(field, s1, s2, ax=None, *, title=None):
     shown = valid[np.linspace(0, len(valid) - 1, min(len(valid), MAX_VECTORS_3D)).astype(int)] if len(valid) else valid
     lengths = np.linalg.norm(field.vectors[shown], axis=1)
     drawn = f", {len(shown)} drawn)" if len(shown) < len(valid) else ")"
-    lines = Line3DCollection(np.stack([field.starts[shown], field.ends[shown]], axis=1), cmap="viridis",
-                             linewidths=0.8, label=f"vectors ({len(valid)}" + drawn)
+    colours = colour_scale(lengths)
+    lines = Line3DCollection(np.stack([field.starts[shown], field.ends[shown]], axis=1), cmap=colours.cmap,
+                             norm=colours.norm, linewidths=0.8, label=f"vectors ({len(valid)}" + drawn)
     lines.set_array(lengths)
     ax.add_collection3d(lines)
-    ax.figure.colorbar(lines, ax=ax, shrink=0.6, label="vector length")
+    colour_bar(ax, lines, colours, f"vector length ({unit_name(unit)})")
     missed = ~field.valid & np.isfinite(field.starts).all(axis=1)
     if missed.any():
         ax.scatter(
@@ -171,10 +177,8 @@ def plot_field_3d(field, s1, s2, ax=None, *, title=None):
         xlim=(centre[0] - half, centre[0] + half),
         ylim=(centre[1] - half, centre[1] + half),
         zlim=(centre[2] - half, centre[2] + half),
-        xlabel="x",
-        ylabel="y",
-        zlabel="z",
     )
+    orient_axes(ax, 3, y_down=y_down, unit=unit)
     ax.set_box_aspect((1, 1, 1))
     ax.legend(loc="upper left", fontsize="small", framealpha=0.8)
     if title is not None:

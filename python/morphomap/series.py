@@ -16,6 +16,7 @@ from ._progress import progress_over
 from ._validate import as_length
 from .carry import IndexedCurve, carry_curve, carry_surface
 from .curves import normals
+from .figure_style import movie_provenance
 from .io.csv_files import write_field_csv
 from .io.meshes import write_surface
 from .io.atomic import atomic_text
@@ -89,13 +90,25 @@ class Series:
     interior : MovingMesh or None
         After :meth:`extend` (or ``map_series(..., interior=...)``): a solver mesh of frame 0's
         domain moved through the frames; None before.
+    unit : str or None
+        The unit of the coordinates, for the figures' axes (``"um"``, or ``"pixel"`` for a movie
+        without a spacing); None where not known (the figures then say ``"units"``).
+    y_down : bool
+        The frames were traced from images (x the column, y the row): the figures draw them as the
+        images look, y down (:mod:`morphomap.figure_style`). Set it for frames given as curves
+        traced from masks.
+    time_unit : str or None
+        The unit of ``dt``, for the animation's time stamps and the speeds' unit: ``"s"`` for a
+        movie's frame interval; None where not known.
     """
 
     def __init__(self, frames, fields, trajectories, quality, *, born=None, cells=None, stretches=None,
-                 accumulated=None, normal_speed=None, accumulated_normal_speed=None, dt=1.0, motion=None):
+                 accumulated=None, normal_speed=None, accumulated_normal_speed=None, dt=1.0, motion=None,
+                 unit=None, y_down=False, time_unit=None):
         self.frames, self.fields, self.trajectories, self.quality = frames, fields, trajectories, quality
         self.motion = motion
         self.interior = None
+        self.unit, self.y_down, self.time_unit = unit, y_down, time_unit
         self.born = np.zeros(trajectories.shape[1], dtype=np.int64) if born is None else born
         self.cells, self._stretches, self._accumulated = cells, stretches, accumulated
         self.normal_speed, self.accumulated_normal_speed, self.dt = normal_speed, accumulated_normal_speed, dt
@@ -153,10 +166,10 @@ class Series:
         """A growth map as colour on the boundary: :func:`morphomap.series_plot.plot_growth`."""
         return plot_growth(self, quantity, step, ax, **options)
 
-    def animate(self, path, *, fps=2, dpi=90) -> None:
+    def animate(self, path, *, fps=2, dpi=90, **options) -> None:
         """Write an animation (``.gif``; ``.mp4`` when ffmpeg is installed) of the frames and the
         followed points: :func:`morphomap.series_plot.animate`."""
-        animate(self, path, fps=fps, dpi=dpi)
+        animate(self, path, fps=fps, dpi=dpi, **options)
 
     def write(self, folder, *, figures=True) -> list:
         """Write into ``folder`` (created) and return the paths:
@@ -326,9 +339,11 @@ def map_series(frames, method="auto", *, dt=None, reseed=2.0, register=None, lab
     ValueError, GeometryError
         A frame or pair that cannot be mapped, named: ``"frames[k] -> frames[k + 1]: ..."``
     """
+    source = {}  # where the frames came from, for the figures: unit, orientation, time unit
     if is_movie_path(frames) or isinstance(frames, Movie):
         movie = frames if isinstance(frames, Movie) else movie_frames(frames, label=label, objects=objects)
         frames = movie.frames
+        source = movie_provenance(movie, dt)
         dt = movie.dt if dt is None else dt
     elif label is not None or objects is not None:
         raise ValueError("label/objects: only for a movie file (frames given as a path); pick the object "
@@ -424,7 +439,7 @@ def map_series(frames, method="auto", *, dt=None, reseed=2.0, register=None, lab
         speed_table[k, : len(v)], mean_table[k, : len(m)] = v, m
     series = Series(frames, fields, trajectories, table, born=born, cells=cells, stretches=stretches,
                     accumulated=accumulated, normal_speed=speed_table, accumulated_normal_speed=mean_table, dt=dt,
-                    motion=motion)
+                    motion=motion, **source)
     if interior is not None:
         series.extend(None if interior is True else interior, progress=progress)
     return series

@@ -8,12 +8,14 @@ import matplotlib.animation as animation
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection
-from matplotlib.colors import Normalize, TwoSlopeNorm
+from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
+from .figure_style import (C1_COLOUR, TIME_MAP, colour_bar, colour_scale, orient_axes, resolve_y_down, speed_unit,
+                           time_stamp, unit_name)
 from .io.atomic import atomic_path
-from .plot import C1_COLOUR, _new_axes, offscreen_figure, save_figure
+from .plot import _new_axes, offscreen_figure, save_figure
 
 #: At most this many trajectories are drawn in 3D (evenly chosen): more only hide the surfaces.
 MAX_TRAJECTORIES_3D = 1500
@@ -27,6 +29,22 @@ _LABELS = {
     "normal_speed": "normal speed",
     "accumulated_normal_speed": "mean normal speed since birth",
 }
+
+
+def _style(series, y_down, unit) -> tuple:
+    """``(y_down, unit)`` for a figure of ``series``: as given, else as the series says its frames
+    came (y-down and the image's unit for frames traced from images)."""
+    y_down = resolve_y_down(y_down, getattr(series, "y_down", False))
+    unit = getattr(series, "unit", None) if unit is None else unit
+    unit_name(unit)  # a bad unit refused before anything is drawn
+    return y_down, unit
+
+
+def _bar_label(series, quantity, unit) -> str:
+    """The colour bar's label of a growth map, with its unit."""
+    if quantity.endswith("stretch"):
+        return f"{_LABELS[quantity]} ({'length' if series.dim == 2 else 'area'} ratio)"
+    return f"{_LABELS[quantity]} ({speed_unit(unit, getattr(series, 'time_unit', None))})"
 
 
 def _check_axes(ax, dim):
@@ -54,7 +72,8 @@ def _draw_frame(ax, series, t, colour, alpha, width=1.0):
                         linewidth=0)
 
 
-def _limits(ax, series, frames):
+def _limits(ax, series, frames, y_down, unit):
+    """Equal, fixed limits around ``frames``, the axes labelled and oriented."""
     everything = np.vstack([_frame_points(series, t) for t in frames])
     low, high = everything.min(axis=0), everything.max(axis=0)
     centre, half = (low + high) / 2, 0.52 * (high - low).max()
@@ -64,8 +83,9 @@ def _limits(ax, series, frames):
         ax.set_aspect("equal")
     else:
         ax.set(xlim=(centre[0] - half, centre[0] + half), ylim=(centre[1] - half, centre[1] + half),
-               zlim=(centre[2] - half, centre[2] + half), xlabel="x", ylabel="y", zlabel="z")
+               zlim=(centre[2] - half, centre[2] + half))
         ax.set_box_aspect((1, 1, 1))
+    orient_axes(ax, series.dim, y_down=y_down, unit=unit)
 
 
 def _trajectory_lines(ax, series, last, norm):
@@ -79,7 +99,7 @@ def _trajectory_lines(ax, series, last, norm):
     times = np.repeat(np.arange(1, last + 1), len(points)).astype(float)
     drawn = np.isfinite(segments).all(axis=(1, 2))
     kind = Line3DCollection if series.dim == 3 else LineCollection
-    lines = kind(segments[drawn], cmap="plasma", norm=norm, linewidths=0.9)
+    lines = kind(segments[drawn], cmap=TIME_MAP, norm=norm, linewidths=0.9)
     lines.set_array(times[drawn])
     if series.dim == 3:
         ax.add_collection3d(lines)
@@ -88,21 +108,33 @@ def _trajectory_lines(ax, series, last, norm):
     return lines
 
 
-def plot_trajectories(series, ax=None, *, title=None):
+def plot_trajectories(series, ax=None, *, title=None, y_down=None, unit=None):
     """Draw the followed points' paths over all frames, coloured by time; returns the ``Axes``.
 
     Every frame's boundary is drawn thin and grey (3D: the first and last surfaces, translucent),
     each point's path as line pieces from frame to frame, coloured by the frame the piece ends on
     (a colour bar gives the frame); in 3D at most :data:`MAX_TRAJECTORIES_3D` paths, evenly chosen.
-    ``ax``: where to draw (a 3D axes for a 3D series), by default a new figure.
+
+    Parameters
+    ----------
+    series : Series
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (a 3D axes for a 3D series), by default a new figure.
+    title : str, optional
+    y_down : bool, optional
+        Draw the frames as their images look (2D: y down; 3D: seen along the stack); by default
+        as :attr:`Series.y_down` says (True for frames traced from images).
+    unit : str, optional
+        The coordinates' unit for the axis labels; by default :attr:`Series.unit`, else ``"units"``.
     """
+    y_down, unit = _style(series, y_down, unit)
     ax = _check_axes(ax, series.dim)
     last = len(series.frames) - 1
     for t in range(len(series.frames)) if series.dim == 2 else (0, last):
         _draw_frame(ax, series, t, "0.6", 0.7 if series.dim == 2 else 0.12, 0.6)
     lines = _trajectory_lines(ax, series, last, Normalize(0, last))
     ax.figure.colorbar(lines, ax=ax, shrink=0.7, label="frame")
-    _limits(ax, series, range(len(series.frames)))
+    _limits(ax, series, range(len(series.frames)), y_down, unit)
     ax.set_title(title if title is not None else f"trajectories of {series.trajectories.shape[1]} points")
     return ax
 
@@ -122,47 +154,92 @@ def growth_map(series, quantity, step):
     return values, cells, series.trajectories[step + 1]
 
 
-def plot_growth(series, quantity="accumulated_stretch", step=-1, ax=None, *, title=None):
+def plot_growth(series, quantity="accumulated_stretch", step=-1, ax=None, *, title=None, scale="robust", y_down=None,
+                unit=None):
     """Draw a growth map as colour on the boundary; returns the ``Axes``.
 
-    ``quantity``: one of :data:`GROWTH_MAPS`; ``step``: the step (default the last), drawn on the
-    followed boundary at its end, frame ``step + 1``: in 2D the pieces between the followed points
-    as coloured lines, in 3D the followed triangles coloured. A sequential colour map, or a diverging
-    one centred on 0 for normal speeds that change sign. Pieces with an unknown value
-    (a lost point) are left out. A colour bar gives the scale.
+    Parameters
+    ----------
+    series : Series
+    quantity : str
+        One of :data:`GROWTH_MAPS`.
+    step : int
+        The step (default the last), drawn on the followed boundary at its end, frame
+        ``step + 1``: in 2D the pieces between the followed points as coloured lines, in 3D the
+        followed triangles coloured. Pieces with an unknown value (a lost point) are left out.
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (a 3D axes for a 3D series), by default a new figure.
+    title : str, optional
+    scale : {"robust", "linear", "log"}
+        The colour scale (:func:`morphomap.figure_style.colour_scale`): by default from the 2nd
+        to the 98th percentile, so that one outlier leaves the rest readable (arrows on the colour
+        bar mark values beyond it); ``"log"`` for stretches. A sequential colour map, or a
+        diverging one centred on 0 for normal speeds that change sign. The colour bar is labelled
+        with the quantity and its unit.
+    y_down, unit : optional
+        As in :func:`plot_trajectories`.
     """
     values, cells, points = growth_map(series, quantity, step)
-    ax = _check_axes(ax, series.dim)
+    y_down, unit = _style(series, y_down, unit)
     shown = np.isfinite(values) & np.isfinite(points[cells]).all(axis=(1, 2))
     values, cells = values[shown], cells[shown]
-    low, high = (float(values.min()), float(values.max())) if len(values) else (0.0, 1.0)
-    if high <= low:
-        low, high = low - 0.5 * abs(low or 1), high + 0.5 * abs(high or 1)
-    both_ways = quantity.endswith("normal_speed") and low < 0 < high  # growing here, shrinking there
-    norm = TwoSlopeNorm(0.0, low, high) if both_ways else Normalize(low, high)
-    cmap = "coolwarm" if both_ways else "viridis"
+    # Growing here, shrinking there: normal speeds are coloured either side of 0.
+    colours = colour_scale(values, scale, diverging=quantity.endswith("normal_speed"))
+    ax = _check_axes(ax, series.dim)
     if series.dim == 2:
-        artist = LineCollection(points[cells], cmap=cmap, norm=norm, linewidths=3)
+        artist = LineCollection(points[cells], cmap=colours.cmap, norm=colours.norm, linewidths=3)
         artist.set_array(values)
         ax.add_collection(artist)
     else:
-        artist = Poly3DCollection(points[cells], cmap=cmap, norm=norm, linewidths=0)
+        artist = Poly3DCollection(points[cells], cmap=colours.cmap, norm=colours.norm, linewidths=0)
         artist.set_array(values)
         ax.add_collection3d(artist)
-    ax.figure.colorbar(artist, ax=ax, shrink=0.7, label=_LABELS[quantity])
+    colour_bar(ax, artist, colours, _bar_label(series, quantity, unit))
     step = series._step(step)
-    _limits(ax, series, (step, step + 1))
+    _limits(ax, series, (step, step + 1), y_down, unit)
     when = f"at frame {step + 1}" if quantity.startswith("accumulated") else f"frames {step} to {step + 1}"
     ax.set_title(title if title is not None else f"{_LABELS[quantity]}, {when}")
     return ax
 
 
-def animate(series, path, *, fps=2, dpi=90):
+def plot_frame(series, t, ax=None, *, y_down=None, unit=None, title=None):
+    """Draw one picture of :func:`animate`: frame ``t``'s boundary, the paths of the followed points
+    so far coloured by time and the points where they are, with limits fixed over all frames;
+    returns the ``Axes``.
+
+    The title stamps the time, ``t * series.dt`` in :attr:`Series.time_unit` (a movie's frame
+    interval in seconds is given in s, min, h or d, whichever suits the series): e.g.
+    ``"t = 1.5 h (frame 3 of 4): 120 points"``; without a known unit, the bare number.
+    ``y_down``, ``unit``: as in :func:`plot_trajectories`.
+    """
+    y_down, unit = _style(series, y_down, unit)
+    last = len(series.frames) - 1
+    if isinstance(t, (bool, np.bool_)) or not isinstance(t, (int, np.integer)):
+        raise TypeError(f"t: expected an integer, got {type(t).__name__}")
+    if not 0 <= t <= last:
+        raise ValueError(f"t: expected a frame 0..{last}, got {t}")
+    ax = _check_axes(ax, series.dim)
+    _draw_frame(ax, series, t, C1_COLOUR, 1.0 if series.dim == 2 else 0.25, 1.6)
+    if t:
+        _trajectory_lines(ax, series, t, Normalize(0, max(last, 1)))
+    now = series.trajectories[t]
+    now = now[np.isfinite(now).all(axis=1)]
+    ax.scatter(*now.T, s=3 if series.dim == 2 else 1, color="black")
+    _limits(ax, series, range(len(series.frames)), y_down, unit)
+    stamp = time_stamp(t, series.dt, getattr(series, "time_unit", None), last)
+    ax.set_title(title if title is not None else f"{stamp} (frame {t} of {last}): {len(now)} points")
+    return ax
+
+
+def animate(series, path, *, fps=2, dpi=90, y_down=None, unit=None):
     """Write an animation of the series to ``path``: ``.gif`` (Pillow) or ``.mp4`` (needs ffmpeg).
 
-    One picture per frame: that frame's boundary, the paths of the followed points so far coloured
-    by time and the points where they are. Fixed limits over all frames. Written atomically.
+    One picture per frame, drawn by :func:`plot_frame` (stamped with its time): that frame's
+    boundary, the paths of the followed points so far coloured by time and the points where they
+    are. Fixed limits over all frames. Written atomically. ``y_down``, ``unit``: as in
+    :func:`plot_trajectories`.
     """
+    y_down, unit = _style(series, y_down, unit)
     name = str(path)
     suffix = name.lower().rsplit(".", 1)[-1] if "." in name else ""
     if suffix == "gif":
@@ -176,20 +253,11 @@ def animate(series, path, *, fps=2, dpi=90):
     figure = Figure(figsize=(6, 6))
     FigureCanvasAgg(figure)
     ax = figure.add_subplot(projection="3d" if series.dim == 3 else None)
-    last = len(series.frames) - 1
-    norm = Normalize(0, max(last, 1))
     with atomic_path(name) as temporary:
         with writer.saving(figure, temporary, dpi):
             for t in range(len(series.frames)):
                 ax.clear()
-                _draw_frame(ax, series, t, C1_COLOUR, 1.0 if series.dim == 2 else 0.25, 1.6)
-                if t:
-                    _trajectory_lines(ax, series, t, norm)
-                now = series.trajectories[t]
-                now = now[np.isfinite(now).all(axis=1)]
-                ax.scatter(*now.T, s=3 if series.dim == 2 else 1, color="black")
-                _limits(ax, series, range(len(series.frames)))
-                ax.set_title(f"frame {t} of {last}: {len(now)} points")
+                plot_frame(series, t, ax, y_down=y_down, unit=unit)
                 writer.grab_frame()
 
 

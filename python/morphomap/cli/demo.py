@@ -23,6 +23,7 @@ import tifffile
 
 from .._core import METHODS, GeometryError
 from ..chooser import BEST
+from ..figure_style import method_summary
 from ..images import boundary_from_mask, read_image, surface_from_mask
 from ..io import EXAMPLES, load_example, write_curve, write_field, write_surface
 from ..io.atomic import atomic_text
@@ -163,8 +164,7 @@ def run(out="morphomap-demo", *, pairs=EXAMPLES, stream=None, plots=True) -> lis
         # The default: per piece the crossing-free, complete candidate of lowest QM.
         field = map_curves(c1, c2)
         q = quality(field, c1, c2, closed=True)
-        names, counts = np.unique(field.method, return_counts=True)
-        used = ", ".join(f"{n} {c}" for n, c in zip(names, counts))
+        used = method_summary(field.method)
         rows.append(Row(pair, "auto", "plain", q.qm1, q.qm2, q.qm, q.crossings, int((~field.valid).sum()),
                         len(field)))
         auto_used[pair] = used
@@ -269,10 +269,10 @@ def run_images(out="morphomap-demo/images", *, stream=None, plots=True) -> list:
 
     def read_both(paths):
         images = [read_image(path) for path in paths]
-        return [image.data for image in images], images[0].spacing
+        return [image.data for image in images], images[0].spacing, images[0].unit
 
     rows2, rows3 = [], []
-    (mask1, mask2), spacing = read_both(_write_frames(out, "kidney", *kidney_masks()))
+    (mask1, mask2), spacing, unit = read_both(_write_frames(out, "kidney", *kidney_masks()))
     c1, c2 = (boundary_from_mask(m, spacing, smooth=min(spacing)) for m in (mask1, mask2))
     write_curve(out / "kidney_c1.csv", c1)
     write_curve(out / "kidney_c2.csv", c2)
@@ -285,13 +285,13 @@ def run_images(out="morphomap-demo/images", *, stream=None, plots=True) -> list:
                 c1,
                 c2,
                 out / f"kidney_{method}",
-                lambda field, ax, title: plot_field(field, c1, c2, ax=ax, title=title, y_down=True),
+                lambda field, ax, title: plot_field(field, c1, c2, ax=ax, title=title, y_down=True, unit=unit),
                 plots,
             )
         )
     makers = {"figure12": ellipsoid_stacks, "lung": lung_stacks}
     for name, methods in STACKS.items():
-        (stack1, stack2), spacing = read_both(_write_frames(out, name, *makers[name]()))
+        (stack1, stack2), spacing, unit = read_both(_write_frames(out, name, *makers[name]()))
         s1, s2 = (surface_from_mask(v, spacing, smooth=min(spacing)) for v in (stack1, stack2))
         write_surface(out / f"{name}_s1.ply", s1)
         write_surface(out / f"{name}_s2.ply", s2)
@@ -304,7 +304,8 @@ def run_images(out="morphomap-demo/images", *, stream=None, plots=True) -> list:
                     s1,
                     s2,
                     out / f"{name}_{method}",
-                    lambda field, ax, title: plot_field_3d(field, s1, s2, ax=ax, title=title),
+                    lambda field, ax, title: plot_field_3d(field, s1, s2, ax=ax, title=title, y_down=True,
+                                                                 unit=unit),
                     plots,
                     projection="3d",
                 )
@@ -333,8 +334,7 @@ def _image_row(pair, method, mapping, b1, b2, stem, draw, plots, projection=None
     write_field(stem.with_suffix(".csv"), field)
     if plots:
         figure = offscreen_figure(7, 7)
-        names, counts = np.unique(field.method, return_counts=True)
-        used = ", ".join(f"{n} {c}" for n, c in zip(names, counts))
+        used = method_summary(field.method)
         draw(
             field,
             figure.add_subplot(projection=projection),

@@ -5,13 +5,13 @@ from __future__ import annotations
 
 import sys
 
-from ..io.frames import read_boundary
+from ..io.frames import read_sourced_boundary
 
 
 def read_frame(path: str, args):
-    """``(frame, from_image)`` for the command line: read_boundary with its options, the spacing
-    used said on stderr."""
-    return read_boundary(
+    """``(frame, from_image, unit)`` for the command line: read_sourced_boundary with its options,
+    the spacing used said on stderr."""
+    return read_sourced_boundary(
         path,
         spacing=args.spacing,
         label=args.label,

@@ -136,7 +136,7 @@ def main(argv=None) -> int:
     mapping.add_argument(
         "--plot",
         metavar="FIELD.png",
-        help="also draw the field into this image file (2D masks: y down, as the image looks)",
+        help="also draw the field into this image file (masks: as the image looks, y down; axes in the image's unit)",
     )
     mapping.set_defaults(run=_command("pair", "run_map", mapping))
     extend = commands.add_parser(

@@ -13,6 +13,7 @@ import morphomap
 from .._core import GeometryError, InvalidInput
 from ..best import candidate_table
 from ..extend import extend_field
+from ..figure_style import method_summary
 from ..io.formats import write_field, write_interior, writer
 from ..mapping import map_curves
 from ..quality import quality
@@ -30,7 +31,8 @@ def _read_and_map(args, parser):
             parser.error(f"cannot read {path}: {error.strerror or error}")
         except (ValueError, TypeError) as error:
             parser.error(f"{path}: {error}")
-    (c1, from_image), (c2, _) = frames
+    (c1, from_image, unit), (c2, _, _) = frames
+    look = {"y_down": from_image, "unit": unit}  # how its figure is drawn: masks as the image looks
     surfaces = [not isinstance(frame, np.ndarray) for frame in (c1, c2)]
     if surfaces[0] != surfaces[1]:
         parser.error(f"{args.c1} is a {'surface' if surfaces[0] else 'curve'} but {args.c2} is a "
@@ -54,12 +56,11 @@ def _read_and_map(args, parser):
             q = quality(field, c1, c2, closed=args.closed)
     except (ValueError, TypeError, InvalidInput, GeometryError) as error:
         parser.error(f"cannot map {args.c1} onto {args.c2} with --method {args.method}: {error}")
-    return c1, c2, from_image, field, q
+    return c1, c2, look, field, q
 
 
 def _summary(field, q) -> str:
-    names, counts = np.unique(field.method, return_counts=True)
-    used = ", ".join(f"{name} {count}" for name, count in zip(names, counts))
+    used = method_summary(field.method)
     defects = f"folds {q.folds}" if field.dim == 3 else f"crossings {q.crossings}"
     return (f"{len(field)} vectors, {int(field.valid.sum())} valid, {int((~field.valid).sum())} missed ({used}); "
             f"QM1 {q.qm1:.4g}  QM2 {q.qm2:.4g}  QM {q.qm:.4g}  {defects}")
@@ -73,7 +74,7 @@ def run_map(args, parser) -> int:
             writer(args.output, "field")  # an unknown suffix before the work, not a traceback after it
         except ValueError as error:
             parser.error(f"-o {args.output}: {error}")
-    c1, c2, from_image, field, q = _read_and_map(args, parser)
+    c1, c2, look, field, q = _read_and_map(args, parser)
     title = f"{args.method}: QM1 {q.qm1:.4g}  QM2 {q.qm2:.4g}  QM {q.qm:.4g}"
     try:
         if args.output == "-":
@@ -88,9 +89,9 @@ def run_map(args, parser) -> int:
             plot = morphomap.plot
             fig = plot.offscreen_figure(7, 7)
             if field.dim == 3:
-                plot.plot_field_3d(field, c1, c2, ax=fig.add_subplot(projection="3d"), title=title)
+                plot.plot_field_3d(field, c1, c2, ax=fig.add_subplot(projection="3d"), title=title, **look)
             else:
-                plot.plot_field(field, c1, c2, ax=fig.subplots(), closed=args.closed, title=title, y_down=from_image)
+                plot.plot_field(field, c1, c2, ax=fig.subplots(), closed=args.closed, title=title, **look)
             plot.save_figure(fig, args.plot, dpi=100)
     except OSError as error:
         parser.error(f"cannot write {error.filename}: {error.strerror or error}")

@@ -22,7 +22,7 @@ def _movie(path: str, args):
 
 
 def run(args, parser) -> int:
-    frames = []
+    frames, sources = [], []
     if len(args.frames) == 1:
         try:
             frames = _movie(args.frames[0], args)
@@ -34,7 +34,9 @@ def run(args, parser) -> int:
         parser.error("--objects: only with one movie file")
     for path in args.frames if len(args.frames) > 1 else ():
         try:
-            frames.append(read_frame(path, args)[0])
+            frame, from_image, unit = read_frame(path, args)
+            frames.append(frame)
+            sources.append((from_image, unit))
         except OSError as error:
             parser.error(f"cannot read {path}: {error.strerror or error}")
         except (ValueError, TypeError) as error:
@@ -51,6 +53,8 @@ def run(args, parser) -> int:
                             interior=interior, progress=False if args.no_progress else None)
     except (ValueError, TypeError, InvalidInput, GeometryError) as error:
         parser.error(str(error))
+    if sources and sources[0][0]:  # frames traced from masks: the figures drawn as the images look
+        series.y_down, series.unit = True, sources[0][1]
     if series.motion is not None:
         for line in describe_motion(series.motion):
             print(line, file=sys.stderr)
