@@ -34,7 +34,8 @@ def test_spheres_and_writing(tmp_path):
     assert [p.split("/")[-1] for p in paths] == ["field_00.csv", "field_00.faces.csv", "field_01.csv",
                                                  "field_01.faces.csv", "frame_00.ply", "frame_01.ply",
                                                  "frame_02.ply", "trajectories.csv", "quality.csv",
-                                                 "points.csv", "stretch.csv", "normal_speed.csv"]
+                                                 "points.csv", "stretch.csv", "normal_speed.csv", "growth.csv",
+                                                 "growth_00.vtu", "growth_01.vtu"]
     for t, frame in enumerate(series.frames):
         surface = mm.read_surface(tmp_path / "out" / f"frame_{t:02d}.ply")
         np.testing.assert_array_equal(surface.vertices, frame.vertices)

@@ -16,6 +16,7 @@ from matplotlib.figure import Figure  # noqa: E402
 from PIL import Image  # noqa: E402
 
 import morphomap as mm  # noqa: E402
+from morphomap.figure_style import TIME_MAP  # noqa: E402
 from conftest import circle  # noqa: E402
 
 
@@ -32,12 +33,18 @@ def spheres():
 
 def test_trajectories_are_coloured_by_frame(curves):
     ax = curves.plot_trajectories(Figure().subplots())
-    lines = ax.collections[-1]
     alive = np.isfinite(curves.trajectories).all(axis=2)
-    # One piece per point and step where the point is alive at both ends, coloured by the step's end.
-    expected = np.concatenate([np.full(int((alive[t - 1] & alive[t]).sum()), t) for t in range(1, 4)])
-    assert np.array_equal(np.sort(lines.get_array()), expected)
-    assert len(ax.lines) == 4  # the frames
+    # The frames (4), then one line per step: a piece per point alive at both ends (pieces apart
+    # by NaN), coloured by the step's end on the colour bar's scale.
+    assert len(ax.lines) == 4 + 3
+    bar = ax.figure.axes[-1]
+    assert bar.get_ylabel() == "frame"
+    for t, line in zip(range(1, 4), ax.lines[4:]):
+        x, y = line.get_data()
+        pieces = np.isfinite(np.asarray(x, dtype=float)).reshape(-1, 3)[:, :2].all(axis=1)
+        assert pieces.sum() == int((alive[t - 1] & alive[t]).sum())
+        assert line.get_color() == tuple(matplotlib.colormaps[TIME_MAP](t / 3))
+
 
 
 def test_growth_maps_colour_the_boundary(curves, spheres):

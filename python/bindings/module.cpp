@@ -21,6 +21,7 @@ void bind_quality(py::module_& m);
 void bind_surfaces(py::module_& m);
 void bind_diffusion3d(py::module_& m);
 void bind_field_at(py::module_& m);
+void bind_growth(py::module_& m);
 void bind_extend(py::module_& m);
 
 PYBIND11_MODULE(_core, m) {
@@ -70,5 +71,6 @@ PYBIND11_MODULE(_core, m) {
   bind_surfaces(m);
   bind_diffusion3d(m);
   bind_field_at(m);
+  bind_growth(m);
   bind_extend(m);
 }

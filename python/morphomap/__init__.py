@@ -24,6 +24,7 @@ from .diffusion import DiffusionSolution, solve_diffusion
 from .diffusion3d import ShellDiffusionSolution, solve_diffusion_3d
 from .extend import InteriorField, extend_field
 from .field import DisplacementField
+from .growth import Growth, SeriesGrowth, distance_bands, growth
 from .mapping import map_curves
 from .moving_mesh import MovingMesh, extend_series
 from .prepared import PreparedCurve, PreparedSurface
@@ -61,12 +62,14 @@ __all__ = [
     "DiffusionSolution",
     "DisplacementField",
     "GeometryError",
+    "Growth",
     "Image",
     "InteriorField",
     "InvalidInput",
     "Job",
     "MovingMesh",
     "Series",
+    "SeriesGrowth",
     "ShellDiffusionSolution",
     "Similarity",
     "SurfaceHits",
@@ -82,8 +85,10 @@ __all__ = [
     "count_crossings",
     "crossing_pairs",
     "curve_intersections",
+    "distance_bands",
     "extend_field",
     "extend_series",
+    "growth",
     "is_self_intersecting",
     "line_intersections",
     "load_example",

@@ -26,6 +26,7 @@ from .moving_mesh import MeshStep, MovingMesh, extend_series
 from .prepared import PreparedCurve, PreparedSurface, as_surface
 from .quality import quality
 from .reseed import reseed_curve, reseed_surface
+from .growth_plot import write_growth
 from .series_plot import animate, plot_growth, plot_trajectories, write_figures
 from .simple import make_simple
 from .surfaces import SurfaceIndex, map_surfaces, surface_normals
@@ -182,6 +183,8 @@ class Series:
         - ``stretch.csv`` (step, piece, its corner points, stretch, accumulated stretch) and
           ``normal_speed.csv`` (step, point, normal speed, accumulated normal speed) with the
           growth maps;
+        - the growth kinematics (:func:`morphomap.growth_plot.write_growth`): ``growth.csv``, in 3D
+          ``growth_KK.vtu`` per step, and with ``figures`` ``kymograph.png`` (2D) or ``growth.png`` (3D);
         - with ``register``: ``motion.csv`` (frame, the matrix of :attr:`motion` row by row, and
           the translation and rotation in words);
         - with :attr:`interior`: ``interior.xdmf`` (+ ``interior.h5``; dolfinx reads the mesh with
@@ -266,6 +269,7 @@ class Series:
                     values = ",".join(repr(float(v)) for v in matrix.ravel())
                     handle.write(f"{k},{values},\"{line}\"\n")
             paths.append(path)
+        paths.extend(write_growth(self, folder, figures=figures))
         if figures:
             paths.extend(write_figures(self, folder))
         return paths

@@ -8,6 +8,7 @@
 #include <morphomap/extend.hpp>
 #include <morphomap/field.hpp>
 #include <morphomap/field_at.hpp>
+#include <morphomap/growth.hpp>
 #include <morphomap/interrupt.hpp>
 #include <morphomap/laplace.hpp>
 #include <morphomap/laplace3d.hpp>
