@@ -26,7 +26,6 @@ from .extend import InteriorField, extend_field
 from .field import DisplacementField
 from .growth import Growth, SeriesGrowth, distance_bands, growth
 from .mapping import map_curves
-from .moving_mesh import MovingMesh, extend_series
 from .prepared import PreparedCurve, PreparedSurface
 from .quality import CurveQuality, SurfaceQuality, quality
 from .queries import CurveHits, CurveIndex, closest_points, line_intersections
@@ -40,6 +39,7 @@ __getattr__, __dir__ = lazy_names(__name__, globals(), {
     "batch": ("Job", "map_batch"),
     "components": ("split_components",),
     "images": ("Image", "boundary_from_mask", "read_image", "surface_from_mask"),
+    "moving_mesh": ("MovingMesh", "extend_series"),
     "io": ("load_example", "read_curve", "read_field", "read_surface", "write_curve", "write_field",
            "write_interior", "write_surface"),
     "plot": ("plot_field", "plot_field_3d"),

@@ -11,6 +11,7 @@ import numpy as np
 from .figure_style import colour_bar, colour_scale, orient_axes, resolve_y_down, speed_unit, time_stamp, unit_name
 from .growth import Growth, series_growth
 from .io.atomic import atomic_path, atomic_text
+from .plot import _new_axes, offscreen_figure, save_figure
 
 #: What a heat map or kymograph can show, and the label of its colour bar (None: a ratio).
 QUANTITIES = {
@@ -80,8 +81,6 @@ def plot_growth_map(growth: Growth, quantity="areal_growth", *, corners=None, ax
     from matplotlib.collections import LineCollection
     from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
-    from .plot import _new_axes
-
     values = _values(growth, quantity)
     reference = growth.before[growth.cells]
     corners = reference if corners is None else np.asarray(corners, dtype=float)
@@ -148,8 +147,6 @@ def plot_kymograph(series, quantity="areal_growth_rate", *, accumulated=False, a
     -------
     the axes
     """
-    from .plot import _new_axes
-
     if series.dim != 2:
         raise ValueError("series: a kymograph is of a 2D series (position along an outline)")
     if quantity == "anisotropy":
@@ -196,8 +193,6 @@ def write_growth(series, folder, *, figures=True) -> list:
             paths.append(_write_vtu(series, k, step, total, os.path.join(folder, f"growth_{k:02d}.vtu")))
     if figures:
         from matplotlib.backends.backend_agg import FigureCanvasAgg
-
-        from .plot import offscreen_figure, save_figure
 
         figure = offscreen_figure(8, 6)
         FigureCanvasAgg(figure)

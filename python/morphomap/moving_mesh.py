@@ -12,6 +12,7 @@ from ._progress import progress_over
 from ._validate import as_length
 from .extend import BOUNDARY_TOLERANCE, InteriorField, extend_field, measure_ratios
 from .field import DisplacementField
+from .io.formats import write_interior_series
 from .queries import CurveIndex
 from .surfaces import SurfaceIndex
 
@@ -112,8 +113,6 @@ class MovingMesh:
         """Write the motion as ``.xdmf`` (one moving mesh: dolfinx reads the mesh with its default
         ``read_mesh()`` and step k with :func:`morphomap.io.fenicsx.read_function` at
         ``time=k * dt``) or ``.pvd`` (ParaView, one ``.vtu`` per step beside it); atomic."""
-        from .io.formats import write_interior_series
-
         write_interior_series(path, self.steps, [k * self.dt for k in range(len(self.steps))])
 
     def __repr__(self) -> str:
