@@ -151,7 +151,8 @@ def test_surfaces():
     outer.vertices *= [1.6, 1.3, 1.1]
     field = mm.map_surfaces(inner, outer, "best", skip_below=1e9)
     assert {c.name for c in field.candidates} == {"normal", "reverse_normal", "minimal_distance",
-                                                  "reverse_minimal_distance", "diffusion", "reverse_diffusion", "auto"}
+                                                  "reverse_minimal_distance", "diffusion", "reverse_diffusion",
+                                                  "optimal", "auto"}
     won = next(c for c in field.candidates if c.status == "won")
     q = mm.quality(field, inner, outer)
     assert q.qm == pytest.approx(won.qm, rel=1e-12) and q.folds == 0 and field.valid.all()

@@ -4,7 +4,8 @@ crossing-free, miss-free one with the lowest QM.
 The candidates (2D, :func:`map_curves`): normal, minimal distance and diffusion mapping, each plain,
 reversed (``reverse=True``), transformed (``transform=True``) and both; ``"optimal"``; and
 ``"auto"`` (the default, itself a per-piece choice among the cheap candidates). 3D
-(:func:`map_surfaces`): normal, minimal distance and diffusion, plain and reversed, and ``"auto"``.
+(:func:`map_surfaces`): normal, minimal distance and diffusion, plain and reversed, ``"optimal"`` and
+``"auto"``.
 Each candidate runs once on the whole pair with the same options (splitting at crossings and
 contact stretches inside it as usual).
 
@@ -109,12 +110,12 @@ _SOLVES_PDE = "diffusion"
 def _plan(form: str, transforms):
     """best's candidates for ``form`` (``"curves"``, ``"surfaces"``) from the core's method table,
     as ``(cheap, expensive)``, each ``[(name, method, reverse, transform)]`` in the order of the
-    candidate table: the basic algorithms that both forms have, each plain and, having a reversed
-    form, reversed, for each of ``transforms`` (normal mapping first); then the form's basic
+    candidate table: the paper's basic algorithms that both forms have, each plain and, having a
+    reversed form, reversed, for each of ``transforms`` (normal mapping first); then the form's basic
     algorithms beyond the paper, plain; then its workflows beyond the paper (the default). The
     ones that solve a Laplace problem are the expensive batch."""
     rows = [row for row in _core.METHODS if getattr(row, form)]
-    common = sorted((row for row in rows if row.basic and row.curves and row.surfaces),
+    common = sorted((row for row in rows if row.basic and row.from_paper and row.curves and row.surfaces),
                     key=lambda row: row.name != _LEADS)
 
     def variants(group):

@@ -42,7 +42,7 @@ constexpr MethodRow kMethodTable[] = {
     {MapMethod::normal, "normal", Method::normal, Method::reverse_normal, true, true, true},
     {MapMethod::diffusion, "diffusion", Method::diffusion, Method::reverse_diffusion, true, true, true},
     {MapMethod::uniform, "uniform", Method::uniform, Method::reverse_uniform, true, true, false},
-    {MapMethod::optimal, "optimal", Method::optimal, Method::reverse_optimal, false, true, false},
+    {MapMethod::optimal, "optimal", Method::optimal, Method::reverse_optimal, false, true, true},
     {MapMethod::paper, "paper", std::nullopt, std::nullopt, true, true, false},
 };
 

@@ -28,7 +28,11 @@ struct SurfaceMappingOptions {
   //   re-placed by harmonic interpolation where that removes them); minimal distance; reverse
   //   normal mapping and reverse minimal distance, carried. Reversed, the same ways from S2,
   //   each carried onto S1 and judged there.
-  // Only the methods kMethodTable marks `surfaces`: uniform, optimal and paper have no 3D form
+  // optimal: auto's field, then its ends moved along S2 so that every triangle's image keeps its
+  //   share of S2's area (the sum of (A'/(alpha A) - 1)^2 over the triangles, QM1 of the 3D quality
+  //   measure, lowered in steps that fold no triangle and keep every end on S2); every vector
+  //   labelled optimal. The radial map between concentric spheres is its minimum.
+  // Only the methods kMethodTable marks `surfaces`: uniform and paper have no 3D form
   // (InvalidInput).
   MapMethod method = MapMethod::automatic;
   // Map S2 -> S1, then carry that field onto S1's vertices: each vertex located on the image of
@@ -39,8 +43,8 @@ struct SurfaceMappingOptions {
   // Called with the name of each stage as it begins, on the calling thread (a progress report);
   // may be empty. diffusion: "mesh", "solve", "trace" (ShellDiffusionOptions::on_stage).
   // automatic: "normal", then, if it falls back, those three for each diffusion it tries (local,
-  // reverse, then forward: they can come up to three times). The other methods
-  // report nothing.
+  // reverse, then forward: they can come up to three times). optimal: auto's, then "optimal".
+  // The other methods report nothing.
   std::function<void(const char* stage)> on_stage;
 };
 

@@ -9,10 +9,12 @@
 #include "common/validation.hpp"
 #include "diffusion/shell_diffusion.hpp"
 #include "diffusion/shell_mesh.hpp"
+#include "mapping/even_surface.hpp"
 #include "mapping/local_diffusion.hpp"
 #include "mapping/surface_fields.hpp"
 #include "quality/folds.hpp"
 #include "surfaces/refine.hpp"
+#include "surfaces/surface_util.hpp"
 
 #include <morphomap/errors.hpp>
 
@@ -337,6 +339,21 @@ DisplacementField3 directed(MapMethod method, const Work& work, const ShellDiffu
   return basic(method, work.user, *work.user_target, diffusion, work.user_source);
 }
 
+// "optimal": auto's field (complete and fold-free, or auto's error), its ends then moved along S2
+// until every triangle's image keeps its share of S2's area (even_ends), every vector labelled
+// optimal.
+DisplacementField3 evened(DisplacementField3 field, const Pair& user, const ShellDiffusionOptions& diffusion) {
+  const Surface& s1 = user.source;
+  const Surface& s2 = user.target;
+  if (diffusion.on_stage) diffusion.on_stage("optimal");
+  const detail::FoldTest test(s1.vertices, s1.faces, s1.vertices, s1.faces, *s1.index, s2.vertices, s2.faces,
+                              *s2.index);
+  const double alpha = detail::surface_area(s2.vertices, s2.faces) / detail::surface_area(s1.vertices, s1.faces);
+  field.ends = detail::even_ends(field.starts, field.ends, field.faces, test, s2.vertices, s2.faces, *s2.index, alpha);
+  std::fill(field.methods.begin(), field.methods.end(), Method::optimal);
+  return field;
+}
+
 // `surface`'s CGAL form: its own (PreparedSurface), else one converted into `built`.
 const detail::ClosedSurface& closed_of(const Surface& surface, std::unique_ptr<const detail::ClosedSurface>& built) {
   if (surface.closed != nullptr) return *surface.closed;
@@ -428,15 +445,19 @@ DisplacementField3 checked(Surface s1, Surface s2, const SurfaceMappingOptions& 
   std::unique_ptr<SurfaceIndex> index_built1, index_built2;
   // S1's own index serves auto's fold test, diffusion's repair and carrying a reversed field
   // back; normal mapping and minimal distance query S2 alone.
-  const bool source_queried =
-      options.reverse || options.method == MapMethod::automatic || options.method == MapMethod::diffusion;
+  const bool starts_from_auto = options.method == MapMethod::automatic || options.method == MapMethod::optimal;
+  const bool source_queried = options.reverse || starts_from_auto || options.method == MapMethod::diffusion;
   detail::run_both([&] { s1.index = source_queried ? &index_of(s1, index_built1) : s1.index; },
                    [&] { s2.index = &index_of(s2, index_built2); });
   const Pair user{s1, s2, nesting};
   Refined refined1, refined2;
-  const bool diffuses = options.method == MapMethod::diffusion || options.method == MapMethod::automatic;
+  const bool diffuses = options.method == MapMethod::diffusion || starts_from_auto;
   const Work work =
       diffuses ? work_pair(user, refined1, refined2) : Work{user, user, s1.index, s2.index, s1.index, s2.index, false};
+  if (options.method == MapMethod::optimal) {
+    return evened(options.reverse ? automatic(work.swapped(), diffusion, &work) : automatic(work, diffusion), user,
+                  diffusion);
+  }
   if (!options.reverse) return directed(options.method, work, diffusion);
   if (options.method == MapMethod::automatic) return automatic(work.swapped(), diffusion, &work);
   return carried(directed(options.method, work.swapped(), diffusion), user, *s1.index, *s2.index);
