@@ -159,6 +159,8 @@ def test_bad_jobs_are_refused_naming_the_job(frames):
         mm.map_batch([Job(paths[0], paths[1], str(folder / "o.csv"), spacing=(0.0,))], progress=False)
     with pytest.raises(ValueError, match=r"jobs\[0\].smooth"):
         mm.map_batch([Job(paths[0], paths[1], str(folder / "o.csv"), smooth=-1)], progress=False)
+    with pytest.raises(ValueError, match=r"workers: expected None or a whole number of at least 1, got 0"):
+        mm.map_batch([Job(paths[0], paths[1], str(folder / "o.csv"))], workers=0, progress=False)
 
 
 def test_manifest_rows_name_the_bad_row_and_column(tmp_path):

@@ -198,6 +198,9 @@ def map_batch(jobs, client=None, *, workers=None, progress=None, task=None, summ
     """
     jobs = list(jobs)
     progress = as_progress(progress)
+    if workers is not None and (not isinstance(workers, (int, np.integer)) or isinstance(workers, bool)
+                                or workers < 1):
+        raise ValueError(f"workers: expected None or a whole number of at least 1, got {workers!r}")
     for k, job in enumerate(jobs):
         _check(k, job)
     outputs = {}
