@@ -172,7 +172,8 @@ def test_manifest_rows_name_the_bad_row_and_column(tmp_path):
         "c1,c2,label\na,b,x\na,b,x\n": r"row 2, column label: 'x' is row 1's label too",
         "c1,c2,label\na,b,../x\n": r"row 1, column label: expected a file-name-safe name",
         "c1,c2,size\na,b,1\n": r"unknown column 'size'",
-        "c1,c2\na,b,c,d\n": r"row 1: 4 values for the 2 columns",
+        "c1,c2,label\na,b,c,d\n": r"row 1: 4 values for the 3 columns",
+        "c1,c2\na,b,c,d\n": r"row 1: expected c1,c2\[,method\]",
         "a,b,c,d\n": r"row 1: expected c1,c2\[,method\]",
         "label,c1,c2\nx,,b\n": r"row 1, column c1: the frame file is missing",
     }

@@ -4,8 +4,8 @@ With a header, the columns are named: ``c1`` and ``c2`` (required: the frame fil
 the manifest's folder unless absolute), and optionally ``label`` (the row's name: its field is
 ``LABEL.csv`` in the output folder, and the summary table names the row by it), ``method``,
 ``spacing`` (one length, or one per axis separated by spaces or semicolons) and ``smooth``. An
-empty cell takes the batch's default. Without a header, a row is ``c1,c2[,method]``. Lines that
-begin with ``#`` and empty lines are skipped.
+empty cell takes the batch's default. Without a header, or under the header ``c1,c2``, a row is
+``c1,c2[,method]``. Lines that begin with ``#`` and empty lines are skipped.
 """
 
 from __future__ import annotations
@@ -73,6 +73,8 @@ def read_manifest(path, out, *, method="auto", spacing=None, smooth=None, method
             raise ValueError(f"{path}: unknown column {unknown[0]!r}; the columns are {', '.join(COLUMNS)}")
         if len(set(header)) != len(header):
             raise ValueError(f"{path}: a column is named twice in the header {','.join(header)}")
+        if header == ["c1", "c2"]:  # the plain header of rows c1,c2[,method]
+            header = None
     base = os.path.dirname(os.path.abspath(path))
     jobs, labels = [], {}
     for number, row in enumerate(rows, start=1):
