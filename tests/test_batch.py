@@ -199,7 +199,7 @@ def test_batch_command_one_worker_manifest_columns_and_summary(tmp_path):
     command = ["batch", tmp_path / "jobs.csv", "--out", tmp_path / "b", "--workers", "1", "--method", "diffusion",
                "--no-progress"]
     done = morphomap(*command)
-    assert done.returncode == 1 and "3 jobs: 2 done or skipped (0 skipped" in done.stderr, done.stderr
+    assert done.returncode == 1 and "3 jobs: 2 done or skipped, 1 failed (0 skipped" in done.stderr, done.stderr
     unit, half = mm.read_field(tmp_path / "b" / "unit.csv"), mm.read_field(tmp_path / "b" / "half.csv")
     assert unit.method[0] == "normal" and half.method[0] == "diffusion"  # the row's method, else --method
     # Spacing 0.5, smoothing 0: the pixel outline at half the size.
@@ -214,6 +214,6 @@ def test_batch_command_one_worker_manifest_columns_and_summary(tmp_path):
         assert int(r["missed"]) == 0 and int(r["defects"]) == 0 and r["attempts"] == "1"
     assert table[2]["qm"] == "" and "at least 3 points" in table[2]["message"]
     again = morphomap(*command)
-    assert "3 jobs: 2 done or skipped (2 skipped" in again.stderr, again.stderr
+    assert "3 jobs: 2 done or skipped, 1 failed (2 skipped" in again.stderr, again.stderr
     with open(tmp_path / "b" / "summary.csv", newline="") as handle:
         assert [r["qm"] for r in csv.DictReader(handle)] == [r["qm"] for r in table]

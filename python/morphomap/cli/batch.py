@@ -37,6 +37,6 @@ def run(args, parser) -> int:
         print(f"{r.status:8s} {name}{r.job.c1} -> {r.job.c2}: {r.message}", file=sys.stderr)
     failed = sum(r.status == "failed" for r in results)
     skipped = sum(r.status == "skipped" for r in results)
-    print(f"{len(results)} jobs: {len(results) - failed} done or skipped ({skipped} skipped, inputs and options "
-          f"unchanged), {failed} failed; fields and {SUMMARY_NAME} in {args.out}", file=sys.stderr)
+    print(f"{len(results)} jobs: {len(results) - failed} done or skipped, {failed} failed ({skipped} skipped: inputs "
+          f"and options unchanged); fields and {SUMMARY_NAME} in {args.out}", file=sys.stderr)
     return 1 if failed else 0
