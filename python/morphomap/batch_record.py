@@ -16,6 +16,7 @@ import json
 import math
 import os
 
+from ._core import build_info
 from .io.atomic import atomic_text
 
 SIDECAR = ".morphomap.json"
@@ -82,9 +83,7 @@ def up_to_date(job, print_: dict) -> dict | None:
 
 def write_sidecar(output: str, print_: dict, report: dict) -> None:
     """Record, atomically, that ``output`` was made from ``print_``, with the job's ``report``."""
-    from . import __version__
-
-    data = {"morphomap": __version__, "fingerprint": print_, **report}
+    data = {"morphomap": build_info()["version"], "fingerprint": print_, **report}
     with atomic_text(sidecar_path(output)) as handle:
         json.dump(data, handle, indent=1, sort_keys=True)
         handle.write("\n")
