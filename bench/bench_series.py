@@ -1,8 +1,6 @@
-"""Time series and batches: `map_series` against the same pairs mapped one by one, and `map_batch`
-on a local Dask cluster against a sequential loop.
+"""Time series: `map_series` against the same pairs mapped one by one.
 
     PYTHONPATH=build/dev-NAME/pkg python3 bench/bench_series.py            (plain tables)
-    PYTHONPATH=build/dev-NAME/pkg python3 bench/bench_series.py --quick    (fewer batch pairs)
 
 1. A 10-frame 2D series, 1,000 points per curve (a circle growing three buds, `method="auto"`):
    per step, `map_series`' own seconds (mapping + quality, from its table) and a plain
@@ -10,11 +8,7 @@ on a local Dask cluster against a sequential loop.
    whole time (carrying the points, the growth maps and re-seeding included).
 2. A 5-frame 3D series, 5,120 faces per surface (an icosphere growing a bud), the same with
    `map_surfaces`. Both with `--method` (default "auto"); series times are the best of `--rounds`.
-3. `map_batch` on a local cluster of 2 worker processes (its start included) against a loop that
-   runs the same 16 jobs in this process one after the other: 3D pairs (a sphere inside an
-   ellipsoid with semi-axes 1.8, 1.6, 1.5, 1,280 faces each, a little larger pair by pair) mapped
-   with "diffusion" (CGAL Mesh_3 and the trace), read from PLY and written to CSV. Target: at
-   least 1.7x on 2 cores.
+`map_batch` against a sequential loop is bench/bench_batch.py.
 
 Prints what else was running (compilers) so that a loaded machine shows in the numbers.
 """
@@ -23,9 +17,7 @@ from __future__ import annotations
 
 import argparse
 import os
-import shutil
 import subprocess
-import tempfile
 import time
 
 import numpy as np
@@ -89,52 +81,11 @@ def series_table(frames, map_pair, method, label, rounds):
     return series
 
 
-def batch_table(pairs: int, workers: int, method: str, subdivisions: int = 3):
-    from morphomap.batch import Job, map_batch, run_job
-
-    folder = tempfile.mkdtemp(prefix="bench_series_")
-    try:
-        sphere = trimesh.creation.icosphere(subdivisions)  # 1,280 faces at 3, 5,120 at 4, 20,480 at 5
-        paths = []
-        for k in range(pairs):  # a sphere inside an ellipsoid, a little larger pair by pair
-            for name, axes in (("inner", [1.0, 1.0, 1.0]), ("outer", [1.8, 1.6, 1.5])):
-                path = os.path.join(folder, f"{name}{k:02d}.ply")
-                mm.write_surface(path, trimesh.Trimesh(sphere.vertices * axes * (1 + 0.02 * k), sphere.faces))
-                paths.append(path)
-        jobs = {kind: [Job(paths[2 * k], paths[2 * k + 1], os.path.join(folder, f"{kind}_{k:02d}.csv"), method)
-                       for k in range(pairs)] for kind in ("loop", "batch")}
-        before = busy()
-        start, cpu = time.perf_counter(), os.times()
-        for job in jobs["loop"]:
-            run_job(job)
-        loop = time.perf_counter() - start
-        # Cores the loop kept busy on average (this process and its meshing children).
-        used = sum(after - before for after, before in zip(os.times()[:4], cpu[:4])) / loop
-        start = time.perf_counter()
-        results = map_batch(jobs["batch"], workers=workers, progress=False)
-        batch = time.perf_counter() - start
-        failed = [r for r in results if r.status != "done"]
-        difference = max((np.abs(mm.read_field(a.output).ends - mm.read_field(b.output).ends).max()
-                          for a, b in zip(jobs["loop"], jobs["batch"]) if os.path.exists(b.output)), default=np.nan)
-        print(f"\n**map_batch: {pairs} 3D pairs ({method}, {len(sphere.faces):,} faces each)**; before: {before}; "
-              f"after: {busy()}\n")
-        print("| sequential loop s | cores it used | map_batch, 2 workers s (cluster start included) | speed-up "
-              "| failed | largest end difference |")
-        print("|---:|---:|---:|---:|---:|---:|")
-        print(f"| {loop:.2f} | {used:.2f} | {batch:.2f} | {loop / batch:.2f}x | {len(failed)} | {difference:.2g} |")
-    finally:
-        shutil.rmtree(folder, ignore_errors=True)
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--quick", action="store_true", help="4 batch pairs instead of 16")
     parser.add_argument("--method", default="auto", help="the series' method, 2D and 3D (default auto)")
     parser.add_argument("--rounds", type=int, default=5, help="series timings: best of this many runs (default 5)")
-    parser.add_argument("--batch-subdivisions", type=int, default=3,
-                        help="icosphere subdivisions of the batch pairs: 3 (1,280 faces, default), 4 (5,120) "
-                             "or 5 (20,480: organ-sized jobs, ~4 min)")
-    parser.add_argument("--skip", default="", help="comma-separated parts to skip: 2d, 3d, batch")
+    parser.add_argument("--skip", default="", help="comma-separated parts to skip: 2d, 3d")
     args = parser.parse_args()
     skip = set(filter(None, args.skip.split(",")))
     print(f"morphomap {mm.__version__}, {os.cpu_count()} cores; {busy()} at the start")
@@ -144,8 +95,6 @@ def main() -> None:
     if "3d" not in skip:
         series_table([budding_surface(t) for t in range(5)], mm.map_surfaces, args.method,
                      f"3D: 5 frames, 5,120 faces per surface, {args.method}", args.rounds)
-    if "batch" not in skip:
-        batch_table(4 if args.quick else 16, 2, "diffusion", args.batch_subdivisions)
 
 
 if __name__ == "__main__":

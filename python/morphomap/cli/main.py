@@ -213,19 +213,22 @@ def main(argv=None) -> int:
     batch = commands.add_parser(
         "batch",
         help="map many pairs on Dask distributed (a local cluster, or --scheduler)",
-        description="Map every pair listed in MANIFEST.csv (rows c1,c2[,method], paths relative to the manifest) as "
-        "a Dask task; a failing task or a dying worker is reported and the others finish; fields are "
-        "written atomically into --out, and a rerun skips the pairs already done.",
+        description="Map every pair listed in MANIFEST.csv as a Dask task: a header names the columns c1,c2 and "
+        "optionally label,method,spacing,smooth (an empty cell: the option's value below), or rows are "
+        "c1,c2[,method]; paths relative to the manifest. A failing job is reported and the others finish; a dying "
+        "worker fails the job it ran, its waiting jobs run elsewhere. Fields (LABEL.csv, else NNN_C1_C2.csv), "
+        "each with a sidecar of what made it, and summary.csv (quality of every row) are written atomically into "
+        "--out; a rerun skips a row only when its input files' contents and options are unchanged.",
     )
     batch.add_argument("manifest", metavar="MANIFEST.csv")
     batch.add_argument("--out", required=True, metavar="DIR")
     batch.add_argument("--scheduler", metavar="ADDRESS", help="a running Dask scheduler (default: a local cluster)")
     batch.add_argument(
         "--workers",
-        type=_positive,
+        type=_workers,
         default=None,
         metavar="N",
-        help="worker processes of the local cluster (default: one per core)",
+        help="worker processes of the local cluster, 1 or more (default: one per core)",
     )
     _share(common, batch, ("--spacing", "--smooth", "--method"))
     batch.add_argument("--no-progress", action="store_true", help="no progress bar (default: one on a terminal)")
@@ -256,14 +259,22 @@ def _reseed(text: str):
     return value
 
 
-def _positive(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
-    if value < 2:
-        raise argparse.ArgumentTypeError(f"expected at least 2, got {value}")
-    return value
+def _whole(least: int):
+    """An argument type: a whole number of at least ``least``."""
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+        if value < least:
+            raise argparse.ArgumentTypeError(f"expected at least {least}, got {value}")
+        return value
+
+    return parse
+
+
+_positive = _whole(2)  # points of a resampled curve
+_workers = _whole(1)
 
 
 def _length(text: str, positive: bool = False) -> float:
