@@ -129,7 +129,7 @@ def map_surfaces(s1, s2, method="auto", *, reverse=False, mesh_size=None, repeat
         triangle would fold and halved until E falls: every step keeps the field fold-free and
         every end on ``s2``. Stops when a step lowers E by less than 1e-6 of it. Every vector
         is labelled ``"optimal"``. Seconds on 10^4 triangles: a local descent, so it lowers QM
-        (6.6x on the lung-like pair, 560x from a sphere onto an ellipsoid) without reaching the
+        (6.6x on the lung-like pair, 3,000x on the paper's Figure 12 pair; bench/README.md) without reaching the
         global optimum of a diffeomorphic registration.
         ``"best"`` (beyond the paper): normal, minimal distance and diffusion, each plain and
         reversed, ``"optimal"`` and ``"auto"``; the one without folds or misses of lowest QM, with the table
