@@ -186,6 +186,22 @@ def test_3d_widget_gives_a_surface_per_frame(viewer, qtbot, notifications):
     assert (faces < len(vertices)).all() and (vertices[faces, 0] == vertices[faces[:, :1], 0]).all()
 
 
+def test_with_drift_removed_the_layers_lie_on_the_image(viewer, qtbot, notifications):
+    movie = growing_bud()
+    movie = np.stack([np.roll(frame, (3 * t, -2 * t), axis=(0, 1)) for t, frame in enumerate(movie)])  # drifting
+    mapped(viewer, qtbot, movie, (1.0, *SPACING_2D), drift="translation")
+    assert errors(notifications) == []
+    tracks = viewer.layers["bud trajectories"].data
+    starts = viewer.layers["bud displacement"].data[:, 0]
+    for t, frame in enumerate(movie):
+        outline = mm.boundary_from_mask(frame, SPACING_2D)  # where the organ is imaged, drift and all
+        # The followed points of frame t, and the start points of step t, on frame t's outline.
+        for on in (tracks[tracks[:, 1] == t, 2:], starts[starts[:, 0] == t, 1:]):
+            physical = np.column_stack([on[:, 1] * SPACING_2D[1], on[:, 0] * SPACING_2D[0]])
+            if len(physical):
+                assert mm.closest_points(physical, outline).distances.max() < 1e-6, t
+
+
 def test_bad_input_is_a_notification_not_an_exception(viewer, qtbot, notifications):
     widget = SeriesWidget(viewer)
     viewer.window.add_dock_widget(widget)
@@ -243,6 +259,23 @@ def picture(viewer, qtbot, path):
     viewer.screenshot(path=str(path), canvas_only=False)
 
 
+def test_settings_and_arrays_are_checked_naming_the_argument():
+    from morphomap.napari.compute import Options, map_labels
+    from morphomap.napari.layers import to_pixels
+
+    with pytest.raises(TypeError, match="labels: expected integer labels"):
+        map_labels(np.zeros((3, 10, 10)), (1.0, 1.0))
+    with pytest.raises(ValueError, match="spacing: expected 2 positive sizes"):
+        map_labels(growing_bud(), (1.0, 0.0))
+    with pytest.raises(ValueError, match="method: 'uniform' does not map surfaces"):
+        map_labels(growing_ball(), SPACING_3D, Options(method="uniform"))
+    with pytest.raises(ValueError, match="label: choose"):
+        map_labels(growing_bud(), SPACING_2D, Options(objects="label"))
+    with pytest.raises(ValueError, match="spacing: expected one size per coordinate"):
+        to_pixels(np.zeros((4, 2)), (1.0, 1.0, 1.0))
+    np.testing.assert_allclose(to_pixels([[3.0, 2.0]], (0.5, 0.25)), [[4.0, 12.0]])  # (x, y) -> (row, column)
+
+
 def test_reader_gives_labels_and_surfaces_at_the_files_scale(tmp_path):
     require_client(napari is not None, "napari (pip install '.[test]')")
     from morphomap.napari.reader import get_reader
@@ -261,6 +294,36 @@ def test_reader_gives_labels_and_surfaces_at_the_files_scale(tmp_path):
     np.testing.assert_allclose(vertices, mesh.vertices[:, ::-1])
     np.testing.assert_array_equal(faces, mesh.faces)
     assert get_reader(str(tmp_path / "notes.txt")) is None
+
+
+@pytest.fixture
+def plugin():
+    """The plugin registered with napari's plugin manager as its entry point registers it where
+    morphomap is installed (here it may run from the source tree)."""
+    from npe2 import PluginManager, PluginManifest
+
+    manager = PluginManager.instance()
+    ours = "morphomap" not in manager._manifests
+    if ours:
+        manager.register(PluginManifest.from_file(ROOT / "python" / "morphomap" / "napari" / "napari.yaml"))
+    yield manager
+    if ours:
+        manager.unregister("morphomap")
+
+
+def test_napari_opens_files_and_docks_the_widget_through_the_manifest(viewer, plugin, qtbot, tmp_path):
+    path = tmp_path / "bud.tif"
+    tifffile.imwrite(path, growing_bud(), imagej=True, resolution=(1 / 0.65, 1 / 0.65),
+                     metadata={"axes": "TYX", "unit": "um", "finterval": 300.0})
+    [layer] = viewer.open(str(path), plugin="morphomap")
+    assert isinstance(layer, napari.layers.Labels) and layer.data.shape == (4, 96, 96)
+    np.testing.assert_allclose(layer.scale, (1.0, 0.65, 0.65))
+    _, widget = viewer.window.add_plugin_dock_widget("morphomap", "Map series")
+    assert isinstance(widget, SeriesWidget) and widget.layer() is layer
+    widget.run()
+    qtbot.waitUntil(lambda: not widget.busy, timeout=WAIT)
+    assert widget.series is not None and widget.series.dt == 300.0 and widget.series.unit == "um"
+    np.testing.assert_allclose(viewer.layers["bud displacement"].scale, (1.0, 0.65, 0.65))
 
 
 class _Events:
