@@ -297,21 +297,17 @@ def test_reader_gives_labels_and_surfaces_at_the_files_scale(tmp_path):
 
 
 @pytest.fixture
-def plugin():
-    """The plugin registered with napari's plugin manager as its entry point registers it where
-    morphomap is installed (here it may run from the source tree)."""
-    from npe2 import PluginManager, PluginManifest
-
-    manager = PluginManager.instance()
-    ours = "morphomap" not in manager._manifests
-    if ours:
-        manager.register(PluginManifest.from_file(ROOT / "python" / "morphomap" / "napari" / "napari.yaml"))
-    yield manager
-    if ours:
-        manager.unregister("morphomap")
+def plugin(request):
+    """napari's plugin manager holding only this plugin, from its manifest (npe2's own test
+    manager, which discovers nothing: installed or run from the source tree, morphomap is there
+    once). Asked for before the viewer, which hands the plugin's commands to napari."""
+    require_client(napari is not None, "napari (pip install '.[test]')")
+    manager = request.getfixturevalue("npe2pm")
+    with manager.tmp_plugin(manifest=str(ROOT / "python" / "morphomap" / "napari" / "napari.yaml")):
+        yield manager
 
 
-def test_napari_opens_files_and_docks_the_widget_through_the_manifest(viewer, plugin, qtbot, tmp_path):
+def test_napari_opens_files_and_docks_the_widget_through_the_manifest(plugin, viewer, qtbot, tmp_path):
     path = tmp_path / "bud.tif"
     tifffile.imwrite(path, growing_bud(), imagej=True, resolution=(1 / 0.65, 1 / 0.65),
                      metadata={"axes": "TYX", "unit": "um", "finterval": 300.0})
