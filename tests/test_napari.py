@@ -152,10 +152,10 @@ def test_2d_widget_layers_are_morphomaps_results_in_row_column(viewer, qtbot, no
     outlines = viewer.layers["bud boundaries"].data
     assert len(outlines) == 4
     np.testing.assert_allclose(outlines[2][:, 1:], as_napari(series.frames[2], SPACING_2D), atol=1e-9)
-    # The colouring of the last frame is the accumulated stretch of its pieces: the bud's stretched.
+    # The colouring of the last frame is the areal growth of its pieces since their birth.
     growth = viewer.layers["bud growth"]
     last = np.asarray(growth.features["growth"])[growth.data[:, 0] == 3]
-    stretch = series.accumulated_stretch(2)
+    stretch = mm.growth(series).accumulated[2].areal_growth
     np.testing.assert_allclose(np.sort(last), np.sort(stretch[np.isfinite(stretch)]))
     assert last.max() > 1.3 and last.min() > 0.5
     # The quality table: one row per step, as series.quality says.

@@ -19,22 +19,26 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..growth import series_growth
+
 #: The name of the growth quantity the boundaries are coloured by (see :func:`piece_growth`).
-GROWTH = "accumulated stretch"
+GROWTH = "areal growth since birth"
 
 
-def piece_growth(series, t: int) -> tuple:
+def piece_growth(series, t: int, found=None) -> tuple:
     """The growth quantity shown on frame ``t``, one value per piece of the followed boundary:
-    ``(cells, values)``, ``cells`` indexing ``series.trajectories[t]``.
+    ``(cells, values)``, ``cells`` indexing ``series.trajectories[t]``; ``found`` the series'
+    :class:`morphomap.growth.SeriesGrowth` where the caller has it (computed here otherwise).
 
     This is the one place where the colouring quantity is chosen (named by :data:`GROWTH`): the
-    accumulated stretch from frame 0 (:meth:`morphomap.series.Series.accumulated_stretch`; 2D the
-    length ratio of each piece, 3D the area ratio of each triangle), 1 on frame 0. Another
-    per-piece quantity (areal growth, anisotropy) replaces it here.
+    areal growth of each piece since its birth (:func:`morphomap.growth`, ``accumulated``; 2D the
+    length ratio, 3D the area ratio), 1 on frame 0. Another quantity of
+    :class:`morphomap.growth.Growth` (its rate, anisotropy) replaces it here.
     """
     if t == 0:
         return series.cells[0], np.ones(len(series.cells[0]))
-    return series.cells[t - 1], series.accumulated_stretch(t - 1)
+    found = series_growth(series) if found is None else found
+    return series.cells[t - 1], found.accumulated[t - 1].areal_growth
 
 
 def to_pixels(points, spacing) -> np.ndarray:
@@ -120,8 +124,9 @@ def growth_points_layer(series, spacing, scale, translate, name="growth") -> tup
     """2D: the growth quantity (:func:`piece_growth`) at the middle of each followed piece, per
     frame, as Points coloured by it (feature ``"growth"``)."""
     rows, values = [], []
+    found = series_growth(series)
     for t in range(len(series.frames)):
-        cells, value = piece_growth(series, t)
+        cells, value = piece_growth(series, t, found)
         points = series.trajectories[t]
         middles = 0.5 * (points[cells[:, 0]] + points[cells[:, 1]]) if len(cells) else np.zeros((0, 2))
         keep = np.isfinite(middles).all(axis=1) & np.isfinite(value)
@@ -139,8 +144,9 @@ def growth_surface_layer(series, spacing, scale, translate, name="growth") -> tu
     row, column)``, so that the current time shows its own, each vertex coloured by the mean of
     the growth quantity (:func:`piece_growth`) of its triangles."""
     vertices, faces, values, offset = [], [], [], 0
+    found = series_growth(series)
     for t in range(len(series.frames)):
-        cells, value = piece_growth(series, t)
+        cells, value = piece_growth(series, t, found)
         points = series.trajectories[t]
         keep = np.isfinite(points[cells]).all(axis=(1, 2)) & np.isfinite(value)
         cells, value = cells[keep], value[keep]
