@@ -52,7 +52,9 @@ struct ExtendOptions {
 // inside it solves the method's equations (P1 finite elements, multifrontal sparse Cholesky in 2D, conjugate
 // gradients first in 3D). Either method extends an affine boundary map to the same affine map.
 // 2D, mesh_cells empty: the region C1 encloses is meshed with CGAL's constrained Delaunay mesher,
-// every point of C1 a node, edges at most mesh_size (0: graded from C1's point spacing).
+// every point of C1 a node, edges at most mesh_size (0: graded from C1's point spacing); a
+// triangle with its three corners on C1 (which would move with the boundary field alone) is
+// split at the midpoint of its longest inner edge.
 // 3D, mesh_cells empty: the region the start triangles enclose (a closed surface) is meshed with
 // CGAL's Mesh_3 (its surface nodes lie on the triangles; a tetrahedron with all four corners on
 // them, which would move with the boundary field alone, gets a node inside by a split of its
