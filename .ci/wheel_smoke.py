@@ -13,7 +13,7 @@ import morphomap as mm
 def check(name, field, c1, c2):
     assert np.isfinite(field.ends).all(), f"{name}: {np.count_nonzero(~np.isfinite(field.ends).all(axis=1))} misses"
     quality = mm.quality(field, c1, c2)
-    print(f"{name}: {len(field.ends)} vectors, methods {sorted(set(field.method))}, {quality}")
+    print(f"{name}: {len(field.ends)} vectors, methods {sorted(map(str, set(field.method)))}, {quality}")
     return quality
 
 
