@@ -2,9 +2,9 @@
 
     python bench/wheel_kernel.py [queries]
 
-SurfaceIndex.closest_points (Embree and TBB) for 10^6 points within 0.1 of an ellipsoid of 20480
-triangles (its vertices moved at random); the median of five runs after one warm-up. The Embree library the process loaded is
-printed too, so the two runs show which copy they used (the wheel's bundled one or Debian's).
+SurfaceIndex.closest_points (Embree and TBB) for 10^6 points within 0.1 of the vertices of an
+ellipsoid of 20480 triangles; the median of five runs after one warm-up. The Embree library the
+process loaded is printed too, so the two runs show which copy they used (the wheel's or Debian's).
 """
 
 import statistics
