@@ -51,7 +51,8 @@ def main():
             seconds = time.perf_counter() - start
             q = mm.quality(field, s1, s2)
             off = index.closest_points(field.ends[field.valid]).distances.max() / np.linalg.norm(s2.extents)
-            print(f"| {name} | {method} | {q.qm:.3g} ({q.qm1:.3g}) | {q.folds} | {off:.1e} | {seconds:.2f} |", flush=True)
+            print(f"| {name} | {method} | {q.qm:.3g} ({q.qm1:.3g}) | {q.folds} | {off:.1e} | {seconds:.2f} |",
+                  flush=True)
 
 
 if __name__ == "__main__":

@@ -120,11 +120,12 @@ def extend_field(field, boundary=None, *, method="harmonic", mesh=None, mesh_siz
         there (:meth:`DisplacementField.at`); ``boundary_distance`` says how far they were. 2D
         without a mesh: the domain is meshed with CGAL's constrained Delaunay mesher, every
         point of C1 a node, and a triangle with its three corners on C1 (which would move with
-        the boundary field alone) split at its longest inner edge. 3D without a mesh: the region S1 (the field's start triangles, a
-        closed surface) encloses is meshed with CGAL's Mesh_3, its surface nodes on S1's
-        triangles, and a tetrahedron with four corners on S1 (which would move with the boundary
-        field alone) split to get a node inside, unless all six of its edges lie on S1; the mesher's
-        random choices are fixed, so the same field gives the same mesh.
+        the boundary field alone) split at its longest inner edge. 3D without a mesh: the region
+        S1 (the field's start triangles, a closed surface) encloses is meshed with CGAL's Mesh_3,
+        its surface nodes on S1's triangles, and a tetrahedron with four corners on S1 (which
+        would move with the boundary field alone) split to get a node inside, unless all six of
+        its edges lie on S1; the mesher's random choices are fixed, so the same field gives the
+        same mesh.
     mesh_size : float, optional
         Without a mesh, 2D: the largest edge (default: graded from C1's point spacing); 3D: the
         edge length of the tetrahedra and surface triangles (default: S1's mean edge).
