@@ -46,9 +46,8 @@ def test_a_spheroid_stretches_along_its_axis():
     # triangle's plane (an orthonormal basis Q of it), by numpy's SVD.
     corners, normal = _face_geometry(vertices, faces)
     for f in range(len(faces)):
-        q = np.linalg.svd(np.column_stack([corners[f, 1] - corners[f, 0], normal[f]]))[0][:, :2]
         q = np.linalg.qr(np.column_stack([corners[f, 1] - corners[f, 0], corners[f, 2] - corners[f, 0]]))[0]
-        u, s, vt = np.linalg.svd(stretch @ q)
+        _, s, vt = np.linalg.svd(stretch @ q)
         np.testing.assert_allclose(g.stretches[f], s, rtol=1e-12)
         if s[0] - s[1] > 1e-6 * s[0]:
             major = q @ vt[0]

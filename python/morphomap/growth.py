@@ -81,10 +81,7 @@ class Growth:
 
     def measure(self) -> np.ndarray:
         """Each element's length (2D) or area (3D) before, ``(F,)``."""
-        corners = self.before[self.cells]
-        if self.dim == 2:
-            return np.linalg.norm(corners[:, 1] - corners[:, 0], axis=1)
-        return 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
+        return element_measures(self.before, self.cells)
 
     def by_region(self, labels, *, per=None) -> dict:
         """Values over regions of the boundary, weighted by the elements' length or area before.
@@ -155,6 +152,15 @@ class Growth:
         repeated = sorted_corners[:, 1:] == sorted_corners[:, :-1]
         return np.where(repeated.any(axis=1), sorted_corners[:, 1:][np.arange(len(corners)), repeated.argmax(axis=1)],
                         sorted_corners[:, 0])
+
+
+def element_measures(points, cells) -> np.ndarray:
+    """The length of each segment ``(F, 2)`` or the area of each triangle ``(F, 3)`` of ``cells``
+    over ``points`` ``(P, d)``, ``(F,)`` (NaN where a corner is)."""
+    corners = points[cells]
+    if cells.shape[1] == 2:
+        return np.linalg.norm(corners[:, 1] - corners[:, 0], axis=1)
+    return 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
 
 
 def distance_bands(points, tip, width) -> np.ndarray:

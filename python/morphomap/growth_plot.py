@@ -130,7 +130,8 @@ def _crosses(growth, reference, corners):
     return np.concatenate(segments)
 
 
-def plot_kymograph(series, quantity="areal_growth_rate", *, accumulated=False, ax=None, scale="robust", unit=None):
+def plot_kymograph(series, quantity="areal_growth_rate", *, accumulated=False, ax=None, scale="robust", unit=None,
+                   found=None):
     """A 2D series' growth as position along the outline (arc length from the followed curve's
     first point, on frame k) against time, one row per step, as morphodynamics draws edge
     velocities: where along the outline the organ grows, and when.
@@ -142,6 +143,8 @@ def plot_kymograph(series, quantity="areal_growth_rate", *, accumulated=False, a
     accumulated : bool
         The values from each piece's birth (else over each step).
     ax, scale, unit : as :func:`plot_growth_map` (unit default: the series').
+    found : SeriesGrowth, optional
+        The series' growth where the caller has it (computed here otherwise).
 
     Returns
     -------
@@ -152,7 +155,7 @@ def plot_kymograph(series, quantity="areal_growth_rate", *, accumulated=False, a
     if quantity == "anisotropy":
         raise ValueError("quantity: a curve has no anisotropy; use 'areal_growth', 'areal_growth_rate' or "
                          "'normal_velocity'")
-    found = series_growth(series)
+    found = series_growth(series) if found is None else found
     rows = found.accumulated if accumulated else found.steps
     unit = getattr(series, "unit", None) if unit is None else unit
     values = np.concatenate([_values(g, quantity) for g in rows])
@@ -198,7 +201,7 @@ def write_growth(series, folder, *, figures=True) -> list:
         FigureCanvasAgg(figure)
         if series.dim == 2:
             name = "kymograph.png"
-            plot_kymograph(series, "areal_growth_rate", accumulated=True, ax=figure.add_subplot())
+            plot_kymograph(series, "areal_growth_rate", accumulated=True, ax=figure.add_subplot(), found=found)
         else:
             name = "growth.png"
             k = len(series.fields) - 1

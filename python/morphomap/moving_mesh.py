@@ -9,10 +9,11 @@ import numpy as np
 
 from ._core import GeometryError
 from ._progress import progress_over
-from ._validate import as_length
+from ._validate import as_length, as_points
 from .extend import BOUNDARY_TOLERANCE, InteriorField, extend_field, measure_ratios
 from .field import DisplacementField
 from .io.formats import write_interior_series
+from .prepared import as_surface
 from .queries import CurveIndex
 from .surfaces import SurfaceIndex
 
@@ -211,6 +212,11 @@ def extend_series(fields, mesh=None, *, frames=None, method="harmonic", mesh_siz
         frames = list(frames)
         if len(frames) != len(fields) + 1:
             raise ValueError(f"frames: expected {len(fields) + 1} (one more than the fields), got {len(frames)}")
+        # Where each step's ends go: frame k + 1, checked before any work.
+        targets = [as_points(f, f"frames[{k}]", 2) if fields[0].dim == 2 else as_surface(f, f"frames[{k}]")
+                   for k, f in enumerate(frames)][1:]
+    else:
+        targets = [_field_frame(f) for f in fields[1:]] + [None]
     steps = []
     for k in progress_over(range(len(fields)), len(fields), progress, "extend_series", "step"):
         try:
@@ -219,22 +225,11 @@ def extend_series(fields, mesh=None, *, frames=None, method="harmonic", mesh_siz
                                 boundary_tolerance=BOUNDARY_TOLERANCE if k == 0 else np.inf)
         except (ValueError, GeometryError) as error:
             raise type(error)(f"fields[{k}]: {error}") from None
-        target = _frame(frames[k + 1]) if frames is not None else _field_frame(fields[k + 1]) \
-            if k + 1 < len(fields) else None
-        if target is not None:
-            step = _onto(step, target, boundary_nodes(step.cells))
+        if targets[k] is not None:
+            step = _onto(step, targets[k], boundary_nodes(step.cells))
         steps.append(step)
         mesh = (step.points + step.displacement, step.cells)
     return MovingMesh(steps, dt)
-
-
-def _frame(frame):
-    """A frame as the curve or the (vertices, faces) surface :func:`_onto` takes."""
-    if hasattr(frame, "vertices"):
-        return np.asarray(frame.vertices, dtype=float), np.asarray(frame.faces)
-    if isinstance(frame, (tuple, list)) and len(frame) == 2:
-        return np.asarray(frame[0], dtype=float), np.asarray(frame[1])
-    return np.asarray(frame, dtype=float)
 
 
 def _field_frame(field):

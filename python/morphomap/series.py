@@ -26,6 +26,7 @@ from .moving_mesh import MeshStep, MovingMesh, extend_series
 from .prepared import PreparedCurve, PreparedSurface, as_surface
 from .quality import quality
 from .reseed import reseed_curve, reseed_surface
+from .growth import element_measures
 from .growth_plot import write_growth
 from .series_plot import animate, plot_growth, plot_trajectories, write_figures
 from .simple import make_simple
@@ -482,7 +483,7 @@ class _CurveBoundary:
         return np.column_stack([chain[: len(after)], after])
 
     def measure(self, cells, points):
-        return np.linalg.norm(points[cells[:, 1]] - points[cells[:, 0]], axis=1)
+        return element_measures(points, cells)
 
     def chain(self, cells):
         """The points in order along the followed curve (none when no piece is left)."""
@@ -530,8 +531,7 @@ class _SurfaceBoundary:
         return faces
 
     def measure(self, cells, points):
-        corners = points[cells]
-        return 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
+        return element_measures(points, cells)
 
     def normals(self, cells, points):
         return surface_normals(np.nan_to_num(points), cells)

@@ -2,13 +2,14 @@
 // the surfaces' own, E = sum_j (r_j - 1)^2 is zero exactly where every triangle's image keeps its
 // share of S2's area (the radial map between concentric spheres, any similarity), and it is QM1
 // of the 3D quality measure, so lowering it is what makes the field even. Its gradient at end q_i
-// of triangle j is 2 (r_j - 1) / (alpha A_j) * dA'_j/dq_i, with dA'/dq_i = n' x (q_k - q_l) / 2 (n'
+// of triangle j is 2 (r_j - 1) / (alpha A_j) * dA'_j/dq_i, with dA'/dq_i = n' x (q_l - q_k) / 2 (n'
 // the image's unit normal, (i, k, l) in order round it). A step moves every end at once by minus
 // its gradient over a diagonal curvature (the sum over its triangles of the squared gradients of
 // their terms: a Gauss-Newton step per end), within S2's tangent plane, then onto S2 by closest
-// point; the step is halved until the energy falls and no triangle folds (a flip-preventing line
-// search, as locally injective parameterisation methods use). Ends that start folded or
-// incomplete are refused by the caller; this keeps a fold-free field fold-free.
+// point. A flip-preventing line search, as locally injective parameterisation methods use: an
+// end's share of the step is quartered at the corners of a triangle the step would fold, and every
+// share halved while the energy does not fall. The caller starts from auto's field, complete and
+// fold-free; every step keeps it so.
 #include "mapping/even_surface.hpp"
 
 #include "common/interrupt_check.hpp"

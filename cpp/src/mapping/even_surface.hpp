@@ -4,8 +4,6 @@
 #include <morphomap/surface_queries.hpp>
 #include <morphomap/types.hpp>
 
-#include <functional>
-
 namespace morphomap::detail {
 
 class FoldTest;
