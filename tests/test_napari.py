@@ -227,6 +227,159 @@ def test_bad_input_is_a_notification_not_an_exception(viewer, qtbot, notificatio
     assert not [name for name in (layer.name for layer in viewer.layers) if "displacement" in name]
 
 
+def disc_and_ellipse(size=96):
+    """Two single frames (rows, columns): a disc, and an ellipse around it (the later, grown organ)."""
+    rows, columns = np.mgrid[:size, :size]
+    disc = (rows - 48) ** 2 + (columns - 44) ** 2 <= 20 ** 2
+    ellipse = ((rows - 48) / 26) ** 2 + ((columns - 46) / 30) ** 2 <= 1
+    return disc.astype(np.uint8), 2 * ellipse.astype(np.uint8)
+
+
+def ball_and_ellipsoid(size=32):
+    """Two single frames (planes, rows, columns): a ball, and an ellipsoid around it."""
+    planes, rows, columns = np.mgrid[:size, :size, :size]
+    ball = (planes - 16) ** 2 + (rows - 16) ** 2 + (columns - 15) ** 2 <= 8 ** 2
+    ellipsoid = ((planes - 16) / 9) ** 2 + ((rows - 16) / 9) ** 2 + ((columns - 17) / 11) ** 2 <= 1
+    return 3 * ball.astype(np.uint8), 5 * ellipsoid.astype(np.uint8)
+
+
+def paired(viewer, qtbot, earlier, later, scale, names=("early", "late")):
+    """The widget docked in ``viewer`` in two-layer mode on Labels layers of ``earlier`` and
+    ``later`` (one frame each); waits for its worker."""
+    for data, name in zip((earlier, later), names):
+        viewer.add_labels(data, scale=scale, name=name)
+    widget = SeriesWidget(viewer)
+    viewer.window.add_dock_widget(widget, name="morphomap: map series")
+    widget.labels.setCurrentText(names[0])
+    widget.later.setCurrentText(names[1])
+    widget.run()
+    qtbot.waitUntil(lambda: not widget.busy, timeout=WAIT)
+    return widget
+
+
+def expected_pair_vectors(field, spacing):
+    """A field of morphomap's as the Vectors layer of the pair holds it: at time index 0."""
+    starts, moves = as_napari(field.starts[field.valid], spacing), as_napari(field.vectors[field.valid], spacing)
+    time = np.zeros((len(starts), 1))
+    return np.stack([np.hstack([time, starts]), np.hstack([time, moves])], axis=1)
+
+
+def check_pair_tracks(tracks, field, spacing):
+    """The Tracks layer of a pair: every start point at time 0, carried by its vector at time 1
+    (points born on the later frame, where the followed ones spread apart, have ids after them)."""
+    assert isinstance(tracks, napari.layers.Tracks)
+    data = tracks.data
+    first = data[data[:, 1] == 0]
+    np.testing.assert_array_equal(first[:, 0], np.arange(len(field.starts)))
+    np.testing.assert_allclose(first[:, 2:], as_napari(field.starts, spacing), atol=1e-9)
+    carried = data[(data[:, 1] == 1) & (data[:, 0] < len(field.starts))]
+    np.testing.assert_allclose(carried[:, 2:], as_napari(field.starts + field.vectors, spacing), atol=1e-9)
+
+
+def test_two_2d_layers_give_map_curves_field(viewer, qtbot, notifications):
+    disc, ellipse = disc_and_ellipse()
+    widget = paired(viewer, qtbot, disc, ellipse, SPACING_2D)
+    assert errors(notifications) == []
+    assert widget.run_button.text() == "Map pair" and "uniform" in [widget.method.itemText(k)
+                                                                   for k in range(widget.method.count())]
+    field = mm.map_curves(mm.boundary_from_mask(disc, SPACING_2D), mm.boundary_from_mask(ellipse, SPACING_2D))
+    assert field.valid.all()
+    vectors = viewer.layers["early to late displacement"]
+    assert isinstance(vectors, napari.layers.Vectors)
+    np.testing.assert_allclose(vectors.data, expected_pair_vectors(field, SPACING_2D), atol=1e-9)
+    np.testing.assert_allclose(vectors.features["length"], np.linalg.norm(field.vectors, axis=1))
+    check_pair_tracks(viewer.layers["early to late trajectories"], field, SPACING_2D)
+    outlines = viewer.layers["early to late boundaries"].data
+    assert len(outlines) == 2
+    np.testing.assert_allclose(outlines[0][:, 1:], as_napari(field.starts, SPACING_2D), atol=1e-9)
+    for name in ("displacement", "trajectories", "boundaries", "growth"):
+        np.testing.assert_allclose(viewer.layers[f"early to late {name}"].scale, (1.0, *SPACING_2D))
+    assert widget.table.rowCount() == 1 and widget.series is not None and len(widget.series.frames) == 2
+    # Back to one layer: the first is a single frame, not a movie, and is refused as such.
+    widget.later.setCurrentText("none")
+    assert widget.run_button.text() == "Map series"
+    assert widget.run() is None and "expected a movie" in errors(notifications)[-1]
+
+
+def test_two_3d_layers_give_map_surfaces_field_and_a_surface(viewer, qtbot, notifications):
+    ball, ellipsoid = ball_and_ellipsoid()
+    widget = paired(viewer, qtbot, ball, ellipsoid, SPACING_3D, names=("ball", "grown"))
+    assert errors(notifications) == []
+    offered = [widget.method.itemText(k) for k in range(widget.method.count())]
+    assert "uniform" not in offered and "diffusion" in offered  # three axes, one frame: surfaces
+    field = mm.map_surfaces(mm.surface_from_mask(ball, SPACING_3D), mm.surface_from_mask(ellipsoid, SPACING_3D))
+    assert field.valid.all()
+    vectors = viewer.layers["ball to grown displacement"]
+    assert vectors.data.shape == (len(field.starts), 2, 4)
+    np.testing.assert_allclose(vectors.data, expected_pair_vectors(field, SPACING_3D), atol=1e-9)
+    check_pair_tracks(viewer.layers["ball to grown trajectories"], field, SPACING_3D)
+    surface = viewer.layers["ball to grown growth"]
+    assert isinstance(surface, napari.layers.Surface)
+    vertices, faces, values = surface.data
+    assert set(np.unique(vertices[:, 0])) == {0.0, 1.0} and np.isfinite(values).all()
+    np.testing.assert_allclose(np.sort(vertices[vertices[:, 0] == 0, 1:], axis=0),
+                               np.sort(as_napari(field.starts, SPACING_3D), axis=0), atol=1e-9)
+    np.testing.assert_allclose(surface.scale, (1.0, *SPACING_3D))
+
+
+def test_two_layers_that_differ_are_a_notification_naming_both(viewer, qtbot, notifications):
+    disc, ellipse = disc_and_ellipse()
+    viewer.add_labels(disc, scale=SPACING_2D, name="early")
+    viewer.add_labels(ellipse[:90], scale=SPACING_2D, name="cropped")
+    viewer.add_labels(ellipse, scale=(0.5, 0.5), name="coarse")
+    viewer.add_labels(ellipse, scale=SPACING_2D, translate=(4.0, 0.0), name="moved")
+    viewer.add_labels(growing_bud(), scale=(1.0, *SPACING_2D), name="movie")  # as napari's own reader opens it
+    viewer.add_labels(growing_bud(), scale=(1.0, *SPACING_2D), name="read", metadata={"axes": "TYX"})  # as ours
+    viewer.add_labels(ellipse, scale=SPACING_2D, name="late")
+    widget = SeriesWidget(viewer)
+    viewer.window.add_dock_widget(widget)
+    assert widget.later.currentText() == "none" and widget.later.itemText(0) == "none"
+    widget.labels.setCurrentText("early")
+    for later, said in (("cropped", "differ in shape, (96, 96) and (90, 96)"),
+                        ("coarse", "differ in scale (pixel size), (0.5, 0.25) and (0.5, 0.5)"),
+                        ("moved", "differ in translate"),
+                        ("movie", "'movie' has one axis more than 'early', (4, 96, 96) and (96, 96)"),
+                        ("read", "labels 'read': a movie (axes TYX, shape (4, 96, 96))")):
+        widget.later.setCurrentText(later)
+        assert widget.run() is None and not widget.busy, later
+        message = errors(notifications)[-1]
+        assert said in message and f"'{later}'" in message, message
+        if later in ("movie", "read"):
+            assert "takes one frame per layer: choose 'none' as the later layer" in message, message
+        else:
+            assert "'early'" in message and ("set the same" in message or "crop" in message), message
+    widget.labels.setCurrentText("read")  # a movie as the earlier layer, too
+    widget.later.setCurrentText("late")
+    assert widget.run() is None and "labels 'read': a movie" in errors(notifications)[-1]
+    assert not [layer.name for layer in viewer.layers if "displacement" in layer.name]
+    # The viewer and the widget go on: the good pair maps.
+    widget.labels.setCurrentText("early")
+    widget.run()
+    qtbot.waitUntil(lambda: not widget.busy, timeout=WAIT)
+    assert isinstance(viewer.layers["early to late displacement"], napari.layers.Vectors)
+    assert len(errors(notifications)) == 6
+
+
+def test_pair_movie_stacks_two_frames_and_names_both_layers():
+    from morphomap.napari.compute import Frame, pair_movie, spatial_dim
+
+    disc, ellipse = disc_and_ellipse()
+    data, spacing, unit = pair_movie(Frame("a", disc, SPACING_2D, (0.0, 0.0), None, "um"),
+                                     Frame("b", ellipse, SPACING_2D, (0.0, 0.0)))
+    assert data.shape == (2, 96, 96) and spacing == SPACING_2D and unit == "um"
+    np.testing.assert_array_equal(data[1], ellipse)
+    with pytest.raises(ValueError, match="labels 'a': a movie \\(axes TYX"):
+        pair_movie(Frame("a", growing_bud(), (1.0, *SPACING_2D), (0.0,) * 3, "TYX"),
+                   Frame("b", growing_bud(), (1.0, *SPACING_2D), (0.0,) * 3, "TYX"))
+    with pytest.raises(ValueError, match="labels 'a' and 'b': differ in unit"):
+        pair_movie(Frame("a", disc, SPACING_2D, (0.0, 0.0), None, "um"),
+                   Frame("b", ellipse, SPACING_2D, (0.0, 0.0), None, "nm"))
+    with pytest.raises(TypeError, match="labels: expected integer labels"):
+        pair_movie(Frame("a", disc * 1.0, SPACING_2D, (0.0, 0.0)), Frame("b", ellipse * 1.0, SPACING_2D, (0.0, 0.0)))
+    assert (spatial_dim(3), spatial_dim(4), spatial_dim(3, single_frame=True),
+            spatial_dim(3, "TYX", single_frame=True), spatial_dim(2, single_frame=True)) == (2, 3, 3, 2, 2)
+
+
 def test_screenshot_shows_the_results(tmp_path):
     """The README's picture made afresh and checked not blank. In a process of its own on the X
     display (pytest-xvfb's Xvfb in CI): napari's canvas is OpenGL, which Qt's offscreen platform

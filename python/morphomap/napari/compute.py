@@ -1,5 +1,6 @@
 """What the widget runs off the viewer's thread: a labels movie as napari holds it, mapped by
-:func:`morphomap.map_series`.
+:func:`morphomap.map_series`; or two single-frame labels layers (an earlier and a later time
+point), stacked by :func:`pair_movie` into a movie of 2 frames and mapped the same way.
 
 Nothing here imports napari or Qt, so that the mapping a viewer shows can be run (and tested) as
 plain Python: :func:`map_labels` takes the layer's array and scale as they are.
@@ -47,6 +48,105 @@ class Options(NamedTuple):
     smooth: Optional[float] = None
     method: str = "auto"
     drift: str = "none"
+
+
+class Frame(NamedTuple):
+    """One labels layer of the two-layer mode as the widget reads it off the viewer.
+
+    Attributes
+    ----------
+    name : str
+        The layer's name, for messages.
+    data : (rows, columns) or (planes, rows, columns) array
+        One frame: no time axis.
+    scale, translate : sequence of float
+        The layer's placement, one value per axis of ``data``.
+    axes : str, optional
+        The file's axes where morphomap's reader opened it (``metadata["axes"]``, ``"TYX"`` for a
+        2D movie); None for a layer made otherwise.
+    unit : str, optional
+        The unit of ``scale`` (``metadata["unit"]``).
+    """
+
+    name: str
+    data: object
+    scale: tuple
+    translate: tuple
+    axes: Optional[str] = None
+    unit: Optional[str] = None
+
+
+def spatial_dim(ndim: int, axes: Optional[str] = None, *, single_frame: bool = False) -> int:
+    """2 (curves) or 3 (surfaces): the spatial dimension of a labels layer of ``ndim`` axes, a
+    movie with time first, or with ``single_frame`` one frame (a layer of 3 axes is then a 3D
+    stack, unless ``axes`` names a T axis)."""
+    timed = not single_frame or "T" in (axes or "")
+    return 3 if ndim - timed >= 3 else 2
+
+
+def _one_frame(frame: Frame) -> np.ndarray:
+    data = np.asarray(frame.data)
+    if frame.axes and "T" in frame.axes:
+        raise ValueError(f"labels {frame.name!r}: a movie (axes {frame.axes}, shape {data.shape}); two-layer "
+                         f"mode takes one frame per layer: choose 'none' as the later layer to map the movie as "
+                         f"a series, or add the two time points as layers of their own")
+    if data.ndim == 4:
+        raise ValueError(f"labels {frame.name!r}: has 4 axes {data.shape}, a 3D movie; two-layer mode takes "
+                         f"one frame per layer: choose 'none' as the later layer to map the movie as a series, "
+                         f"or add the two time points as layers of their own")
+    if data.ndim not in (2, 3):
+        raise ValueError(f"labels {frame.name!r}: expected one frame, (rows, columns) or (planes, rows, columns), "
+                         f"got {data.ndim} axes {data.shape}")
+    return data
+
+
+def _same(values, other) -> bool:
+    return np.allclose(np.asarray(values, dtype=float), np.asarray(other, dtype=float), rtol=1e-9, atol=0.0)
+
+
+def pair_movie(earlier: Frame, later: Frame) -> tuple:
+    """Two single-frame labels layers as a movie of 2 frames, for :func:`map_labels`.
+
+    Both must be one frame (no time axis: a layer of 3 axes is a 3D stack, unless ``axes`` names
+    a T axis), of the same shape, scale and translate (the mapping goes pixel to pixel), and of
+    the same unit where both state one. A movie is refused, not cut to one of its time points.
+
+    Returns
+    -------
+    (data, spacing, unit)
+        ``data`` the two frames stacked, time first (earlier, later); ``spacing`` the pixel
+        size, in napari's order; ``unit`` the one stated (or None).
+
+    Raises
+    ------
+    ValueError
+        Naming both layers, what differs, and what to do.
+    """
+    first, second = _one_frame(earlier), _one_frame(later)
+    names = f"labels {earlier.name!r} and {later.name!r}"
+    if first.ndim != second.ndim and (first.shape[1:] == second.shape or second.shape[1:] == first.shape):
+        more, less = (earlier, later) if first.ndim > second.ndim else (later, earlier)
+        raise ValueError(f"{names}: {more.name!r} has one axis more than {less.name!r}, "
+                         f"{np.shape(more.data)} and {np.shape(less.data)}: a movie of 2D frames? Two-layer mode "
+                         f"takes one frame per layer: choose 'none' as the later layer to map the movie as a "
+                         f"series, or add the two time points as layers of their own")
+    if first.shape != second.shape:
+        raise ValueError(f"{names}: differ in shape, {first.shape} and {second.shape}; two-layer mode maps "
+                         f"pixel to pixel: give both the same shape (crop, pad or resample one onto the other's "
+                         f"grid)")
+    if not _same(earlier.scale, later.scale):
+        raise ValueError(f"{names}: differ in scale (pixel size), {tuple(earlier.scale)} and "
+                         f"{tuple(later.scale)}; set the same scale on both layers, or resample one onto the "
+                         f"other's grid")
+    if not _same(earlier.translate, later.translate):
+        raise ValueError(f"{names}: differ in translate, {tuple(earlier.translate)} and "
+                         f"{tuple(later.translate)}; the mapping goes pixel to pixel: set the same translate on "
+                         f"both layers")
+    if earlier.unit and later.unit and earlier.unit != later.unit:
+        raise ValueError(f"{names}: differ in unit, {earlier.unit!r} and {later.unit!r}; give both scales in one "
+                         f"unit (convert one layer's scale)")
+    data, spacing = check_labels(np.stack([first, second]), earlier.scale)
+    return data, spacing, earlier.unit or later.unit
 
 
 def methods(dim: int) -> tuple:

@@ -1,5 +1,6 @@
-"""The plugin's widget: a labels movie in the viewer mapped by :func:`morphomap.map_series` in a
-thread worker, its results added as layers and its quality shown in a table.
+"""The plugin's widget: a labels movie in the viewer, or two single-frame labels layers (an
+earlier and a later time point), mapped by :func:`morphomap.map_series` in a thread worker, its
+results added as layers and its quality shown in a table.
 
 Every failure (no labels layer, an empty object, a pair that cannot be mapped, a folder that
 cannot be written) is shown as a napari error notification; nothing raises out of the viewer.
@@ -16,7 +17,7 @@ from napari.utils.notifications import show_error, show_info, show_warning
 from qtpy.QtWidgets import (QComboBox, QDoubleSpinBox, QFileDialog, QFormLayout, QLabel, QPushButton, QSpinBox,
                             QTableWidget, QTableWidgetItem, QVBoxLayout, QWidget)
 
-from .compute import CHOICES, DRIFT, Options, check_labels, map_labels, methods
+from .compute import CHOICES, DRIFT, Frame, Options, check_labels, map_labels, methods, pair_movie, spatial_dim
 from .layers import series_layers
 
 #: The quality table's columns: a title and how to read it off a row of ``series.quality``.
@@ -25,6 +26,16 @@ COLUMNS = (("step", lambda q: str(q.step)), ("QM1", lambda q: f"{q.qm1:.3f}"), (
            ("misses", lambda q: str(q.misses)))
 #: The smoothing box's lowest value stands for None (the mask readers' own default width).
 AUTO_SMOOTH = -0.1
+#: The later layer's choice that maps the first layer alone, as a movie.
+NONE = "none"
+#: What the two layer boxes say when the mouse rests on them.
+LABELS_TIP = ("The labels to map: a movie with time first (2D + t or 3D + t), mapped as a series; or, "
+              "with a later layer chosen below, the earlier of two time points.")
+LATER_TIP = ("Two-layer mode: the later time point, mapped from the layer above (the earlier). Each layer is "
+             "one frame without a time axis (2D: rows, columns; 3D: planes, rows, columns; a layer of three "
+             "axes is a 3D stack unless morphomap's reader opened it as a 2D movie); a movie is refused, not "
+             "cut to its current time step. Both need the same shape, scale and translate. The results have "
+             "a time axis of 2: 0 the earlier layer, 1 the later. 'none': map the layer above as a movie.")
 
 
 def _map_in_steps(data, spacing, options, dt, unit, scale, translate):
@@ -39,8 +50,21 @@ def _map_in_steps(data, spacing, options, dt, unit, scale, translate):
     return series, layers, [str(w.message) for w in caught]
 
 
+def _frame(layer) -> Frame:
+    """A napari Labels layer as :func:`morphomap.napari.compute.pair_movie` takes it."""
+    metadata = layer.metadata or {}
+    return Frame(layer.name, layer.data, tuple(float(v) for v in layer.scale),
+                 tuple(float(v) for v in layer.translate), metadata.get("axes"), metadata.get("unit"))
+
+
 class SeriesWidget(QWidget):
-    """Map a Labels movie (2D + t or 3D + t) through time and show the result.
+    """Map a Labels movie (2D + t or 3D + t) through time, or one Labels layer onto another (two
+    single frames, 2D or 3D: the earlier and the later time point), and show the result.
+
+    Two-layer mode (a layer chosen in ``later``) stacks the two frames into a movie of 2 frames
+    and maps it as a series, so that the results are the same layers with a time axis of 2. Each
+    layer must be one frame: a movie is refused with a notification, never cut to its current
+    time step. The two must have the same shape, scale and translate.
 
     Parameters
     ----------
@@ -49,6 +73,9 @@ class SeriesWidget(QWidget):
 
     Attributes
     ----------
+    labels, later : QComboBox
+        The Labels layer to map (a movie, or the earlier frame), and the later frame (``"none"``:
+        map ``labels`` as a movie).
     series : morphomap.series.Series or None
         The last result.
     busy : bool
@@ -58,8 +85,11 @@ class SeriesWidget(QWidget):
     def __init__(self, napari_viewer):
         super().__init__()
         self.viewer = napari_viewer
-        self.series, self.busy, self._source = None, False, None
+        self.series, self.busy, self._source, self._frames_note = None, False, None, ""
         self.labels = QComboBox()
+        self.labels.setToolTip(LABELS_TIP)
+        self.later = QComboBox()
+        self.later.setToolTip(LATER_TIP)
         self.objects = QComboBox()
         self.objects.addItems(CHOICES)
         self.label = QSpinBox()
@@ -82,8 +112,9 @@ class SeriesWidget(QWidget):
         self.table = QTableWidget(0, len(COLUMNS))
         self.table.setHorizontalHeaderLabels([title for title, _ in COLUMNS])
         form = QFormLayout()
-        for title, box in (("labels", self.labels), ("object", self.objects), ("label", self.label),
-                           ("smoothing", self.smooth), ("method", self.method), ("drift", self.drift)):
+        for title, box in (("labels", self.labels), ("later labels", self.later), ("object", self.objects),
+                           ("label", self.label), ("smoothing", self.smooth), ("method", self.method),
+                           ("drift", self.drift)):
             form.addRow(title, box)
         layout = QVBoxLayout(self)
         layout.addLayout(form)
@@ -92,6 +123,7 @@ class SeriesWidget(QWidget):
         self.run_button.clicked.connect(self.run)
         self.write_button.clicked.connect(lambda: self.write())
         self.labels.currentIndexChanged.connect(self._offer_methods)
+        self.later.currentIndexChanged.connect(self._offer_methods)
         for event in (napari_viewer.layers.events.inserted, napari_viewer.layers.events.removed,
                       napari_viewer.layers.events.moved):
             event.connect(self._offer_layers)
@@ -102,19 +134,23 @@ class SeriesWidget(QWidget):
         return [layer for layer in self.viewer.layers if isinstance(layer, Labels)]
 
     def _offer_layers(self, *_):
-        current = self.labels.currentText()
         names = [layer.name for layer in self._labels_layers()]
-        self.labels.blockSignals(True)
-        self.labels.clear()
-        self.labels.addItems(names)
-        if current in names:
-            self.labels.setCurrentText(current)
-        self.labels.blockSignals(False)
+        for box, offered in ((self.labels, names), (self.later, [NONE] + names)):
+            current = box.currentText()
+            box.blockSignals(True)
+            box.clear()
+            box.addItems(offered)
+            if current in offered:
+                box.setCurrentText(current)
+            box.blockSignals(False)
         self._offer_methods()
 
     def _offer_methods(self, *_):
         layer = self.layer()
-        dim = 3 if layer is not None and layer.data.ndim == 4 else 2
+        single = self.later_layer() is not None
+        dim = 2 if layer is None else spatial_dim(layer.data.ndim, (layer.metadata or {}).get("axes"),
+                                                   single_frame=single)
+        self.run_button.setText("Map pair" if single else "Map series")
         current = self.method.currentText() or "auto"
         self.method.clear()
         self.method.addItems(methods(dim))
@@ -124,6 +160,13 @@ class SeriesWidget(QWidget):
     def layer(self):
         """The chosen Labels layer, or None."""
         name = self.labels.currentText()
+        return next((layer for layer in self._labels_layers() if layer.name == name), None)
+
+    def later_layer(self):
+        """The Labels layer chosen as the later time point (two-layer mode), or None."""
+        name = self.later.currentText()
+        if name in ("", NONE):
+            return None
         return next((layer for layer in self._labels_layers() if layer.name == name), None)
 
     def options(self) -> Options:
@@ -142,29 +185,40 @@ class SeriesWidget(QWidget):
             show_info("morphomap: a series is already being mapped")
             return None
         try:
-            layer = self.layer()
-            if layer is None:
-                raise ValueError("labels: no Labels layer to map; open or add a labels movie (time first)")
-            spacing = tuple(float(v) for v in layer.scale[1:])
-            data, spacing = check_labels(layer.data, spacing)
-            metadata = layer.metadata or {}
-            dt, unit = metadata.get("frame_interval"), metadata.get("unit")
-            scale, translate = tuple(layer.scale), tuple(layer.translate)
+            source, data, spacing, dt, unit, scale, translate = self._input()
             options = self.options()
         except (ValueError, TypeError) as error:
             show_error(f"morphomap: {error}")
             return None
-        self.busy, self._source = True, layer.name
-        self.status.setText(f"mapping {layer.name}…")
+        self.busy, self._source = True, source
+        self.status.setText(f"mapping {source}…")
         return create_worker(_map_in_steps, np.asarray(data), spacing, options, dt, unit, scale, translate,
                              _progress={"total": 2, "desc": "morphomap: mapping"},
-                             _connect={"returned": self._show, "errored": self._failed, "finished": self._idle})
+                             _connect={"returned": self._show, "errored": self._map_failed, "finished": self._idle})
+
+    def _input(self) -> tuple:
+        """``(name, data, spacing, dt, unit, scale, translate)`` of the chosen layer (a movie), or
+        of the two chosen layers stacked into a movie of 2 frames; raises where they cannot be
+        mapped."""
+        layer, later = self.layer(), self.later_layer()
+        if layer is None:
+            raise ValueError("labels: no Labels layer to map; open or add a labels movie (time first)")
+        self._frames_note = ""
+        if later is None:
+            data, spacing = check_labels(layer.data, tuple(float(v) for v in layer.scale[1:]))
+            metadata = layer.metadata or {}
+            return (layer.name, data, spacing, metadata.get("frame_interval"), metadata.get("unit"),
+                    tuple(layer.scale), tuple(layer.translate))
+        data, spacing, unit = pair_movie(_frame(layer), _frame(later))
+        self._frames_note = f" (frame 0 is the layer {layer.name!r}, frame 1 the layer {later.name!r})"
+        return (f"{layer.name} to {later.name}", data, spacing, None, unit, (1.0, *layer.scale),
+                (0.0, *layer.translate))
 
     def _show(self, result):
         series, layers, said = result
         try:
             for message in dict.fromkeys(said):
-                show_warning(f"morphomap: {message}")
+                show_warning(f"morphomap: {message}{self._frames_note}")
             for data, options, kind in layers:
                 name = f"{self._source} {options['name']}"
                 if name in self.viewer.layers:
@@ -187,9 +241,12 @@ class SeriesWidget(QWidget):
                 self.table.setItem(row, column, QTableWidgetItem(read(q)))
         self.table.resizeColumnsToContents()
 
-    def _failed(self, error):
+    def _map_failed(self, error):
+        self._failed(error, self._frames_note)
+
+    def _failed(self, error, note=""):
         self.status.setText("failed")
-        show_error(f"morphomap: {error}")
+        show_error(f"morphomap: {error}{note}")
 
     def _idle(self, *_):
         self.busy = False
