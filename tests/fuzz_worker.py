@@ -154,7 +154,7 @@ class Worker:
                 result["surface_folds"] = int(mm.quality(field, made.s1, made.s2).folds)
             except Exception as error:  # noqa: BLE001
                 result["check_error"] = f"quality: {type(error).__name__}: {error}"[:MESSAGE_LIMIT]
-        if method not in ("diffusion", "auto"):
+        if method not in ("diffusion", "auto", "optimal"):
             return result
 
         # The ends lie on C2 (S2), the starts on C1 (S1).

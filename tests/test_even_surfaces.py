@@ -40,7 +40,9 @@ def test_lung_pair_lower_qm_without_folds():
     qa, qe = mm.quality(auto, s1, s2), mm.quality(even, s1, s2)
     assert qe.folds == 0 and even.valid.all() and len(even) == len(s1.vertices)
     assert _off_s2(even, s2) < 1e-9
-    assert qe.qm < 0.5 * qa.qm  # measured: 5.87 -> 0.89
+    # LDDMM with a varifold loss reaches 0.087 on this pair in minutes (issue "even 3D"); measured
+    # here 5.87 -> 0.001.
+    assert qe.qm <= 0.087 and qe.qm < 0.5 * qa.qm
 
 
 def test_best_in_3d_tries_optimal():
@@ -53,13 +55,20 @@ def test_best_in_3d_tries_optimal():
     assert mm.quality(field, s1, s2).qm <= [c.qm for c in field.candidates if c.name == "optimal"][0]
 
 
-@pytest.mark.parametrize("pair", [("250", "270"), ("270", "290"), ("290", "270")])
-def test_limb_stages_stay_fold_free_and_on_s2(pair):
+# The stages remeshed (edges of 30 units) and as given (coarse, flat caps of long thin triangles;
+# 270 and 290 h cross near the flank). 290 -> 250 h is left out: the default raises there (no
+# method maps it fold-free, bench/README "Real 3D stages") and "optimal" starts from its field.
+@pytest.mark.parametrize("pair,edge", [(("250", "270"), 30.0), (("270", "290"), 30.0), (("290", "270"), 30.0),
+                                       (("250", "270"), None), (("270", "250"), None), (("270", "290"), None),
+                                       (("290", "270"), None), (("250", "290"), None)])
+def test_limb_stages_halve_auto_qm_fold_free_on_s2(pair, edge):
     folder = SHARED_CASES / "limb-bud" / "3d"
     require_cases(folder)
-    s1, s2 = (mm.remesh_surface(mm.read_surface(folder / f"limb_{h}h_closed.ply"), 30.0) for h in pair)
+    s1, s2 = (mm.read_surface(folder / f"limb_{h}h_closed.ply") for h in pair)
+    if edge is not None:
+        s1, s2 = (mm.remesh_surface(s, edge) for s in (s1, s2))
     auto = mm.map_surfaces(s1, s2)
     even = mm.map_surfaces(s1, s2, "optimal")
     qa, qe = mm.quality(auto, s1, s2), mm.quality(even, s1, s2)
-    assert qe.folds == 0 and even.valid.all() and _off_s2(even, s2) < 1e-9
-    assert qe.qm1 <= qa.qm1
+    assert qe.folds == 0 and even.valid.all() and len(even) == len(s1.vertices) and _off_s2(even, s2) < 1e-9
+    assert qe.qm <= 0.5 * qa.qm  # the issue's target; measured 21x-2,000x lower (bench/README)

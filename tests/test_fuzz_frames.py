@@ -15,15 +15,17 @@ Invariants, one test per category and dimension (``test_fuzz_2d[crash]``, ...):
 - ``unexpected_exception``: an exception other than ValueError / TypeError / morphomap.GeometryError;
 - ``unnamed_error``: a ValueError / TypeError whose message does not start with the argument's name;
 - ``empty_region``: "the region between the curves is empty" although C1 and C2 differ;
-- ``auto_raised``: ``method="auto"`` raised on a pair where a basic method answered the same way
+- ``auto_raised``: ``method="auto"`` (in 3D also ``"optimal"``, which starts from auto's field)
+  raised on a pair where a basic method answered the same way
   round (plain or reverse; without misses, and in 2D without crossings, in 3D without folds, as
   the default's contract asks);
   ``auto_raised_raw`` the same on a raw pair (invalid curves or meshes, where the error may be
   right but the rule asks for an answer);
 - ``auto_crossings`` (2D): the default returned crossings or misses (it must raise instead);
-- ``auto_folds`` (3D): the default returned folded triangles or misses (it must raise instead);
+- ``auto_folds`` (3D): the default or ``optimal`` returned folded triangles or misses (it must
+  raise instead);
 - ``not_s1_field`` (3D): a field that is not one vector per vertex of S1 (every method's is);
-- ``ends_off_target`` / ``starts_off_source``: diffusion and auto ends not on C2 (S2), starts not
+- ``ends_off_target`` / ``starts_off_source``: diffusion, auto and optimal ends not on C2 (S2), starts not
   on C1 (S1), within 1e-6 of the curve's (surface's) bounding-box diagonal;
 - ``out_of_order`` (2D diffusion): the ends, in the order of their starts along C1, step back along C2
   (the paper's "crossing": the order of the points kept is what diffusion guarantees; straight vectors
@@ -113,7 +115,7 @@ STARTUP_TIMEOUT = 300.0
 REPORT = os.environ.get("MORPHOMAP_FUZZ_REPORT", "").strip()
 
 METHODS = {2: ("minimal_distance", "normal", "diffusion", "uniform", "auto"),
-           3: ("minimal_distance", "normal", "diffusion", "auto")}
+           3: ("minimal_distance", "normal", "diffusion", "auto", "optimal")}
 BASIC = {"minimal_distance", "normal", "diffusion", "uniform"}
 
 CATEGORIES = {
@@ -450,7 +452,7 @@ def classify(records):
                 failures["unnamed_error"].append((record, message))
             if "is empty" in record["message"] and not record.get("identical", False):
                 failures["empty_region"].append((record, message))
-            if record["method"] == "auto" and answered.get(way(record)):
+            if record["method"] in ("auto", "optimal") and answered.get(way(record)):
                 basic = ", ".join(answered[way(record)][:4])
                 category = "auto_raised" if record["style"] == "careful" else "auto_raised_raw"
                 failures[category].append((record, f"{message} (answered: {basic})"))
@@ -460,7 +462,7 @@ def classify(records):
                 record.get("crossings", 0) or record.get("valid") != record.get("vectors")):
             failures["auto_crossings"].append(
                 (record, f"{record.get('crossings')} crossing pairs, {record['vectors'] - record['valid']} misses"))
-        if record["method"] == "auto" and record["dim"] == 3 and (
+        if record["method"] in ("auto", "optimal") and record["dim"] == 3 and (
                 record.get("surface_folds", 0) or record.get("valid") != record.get("vectors")):
             misses = record["vectors"] - record["valid"]
             failures["auto_folds"].append((record, f"{record.get('surface_folds')} folded triangles, {misses} misses"))

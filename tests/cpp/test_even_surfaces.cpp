@@ -1,5 +1,9 @@
 // map_surfaces with MapMethod::optimal: concentric spheres keep the radial map; a sphere onto an
-// ellipsoid around it gets a lower QM1 than auto's field, with no fold and every end on S2.
+// ellipsoid around it gets a lower QM1 than auto's field, with no fold and every end on S2. The
+// descent (through its private header) turns back the triangles of a field folded at the start.
+#include "mapping/even_surface.hpp"
+#include "quality/folds.hpp"
+
 #include <morphomap/quality.hpp>
 #include <morphomap/surface_mapping.hpp>
 #include <morphomap/surface_queries.hpp>
@@ -35,5 +39,24 @@ int main() {
   CHECK(q_even.qm1 < 0.01 * q_auto.qm1);
   const auto on = morphomap::closest_points(even.ends, ellipsoid, s.faces);
   CHECK(on.distances.maxCoeff() < 1e-9);
+
+  // The radial field onto the doubled sphere with one end thrown past a neighbour's: its
+  // triangles fold; the descent unfolds them, every end staying on S2.
+  const morphomap::SurfaceIndex index1(s.vertices, s.faces), index2(twice, s.faces);
+  const morphomap::detail::FoldTest test(s.vertices, s.faces, s.vertices, s.faces, index1, twice, s.faces, index2);
+  Points3 folded = twice;
+  const Index moved = s.faces(0, 0), neighbour = s.faces(0, 1);
+  folded.row(moved) = index2
+                          .closest_points(Points3(2.0 * (s.vertices.row(moved) +
+                                                         2.5 * (s.vertices.row(neighbour) - s.vertices.row(moved)))))
+                          .points.row(0);
+  Index before = 0;
+  for (const char f : test.folded(folded)) before += f;
+  CHECK(before > 0);
+  const Points3 unfolded = morphomap::detail::even_ends(s.vertices, folded, s.faces, test, twice, s.faces, index2, 4.0);
+  Index after = 0;
+  for (const char f : test.folded(unfolded)) after += f;
+  CHECK(after == 0);
+  CHECK(index2.closest_points(unfolded).distances.maxCoeff() < 1e-9);
   TEST_MAIN_END();
 }

@@ -233,12 +233,87 @@ std::optional<DisplacementField3> smoothed_over_folds(const DisplacementField3& 
   return std::nullopt;
 }
 
+// The last resort of "auto": a complete candidate's ends around its folded triangles (within
+// kUntangleRings edges of them) moved along S2 by even_ends, which turns folded triangles back
+// while it evens the areas, the ends beyond held; kept only where no triangle is left folded (limb
+// bud 290 -> 250 h: every candidate folds 2-20 triangles at the tip; bench/README.md "Real 3D
+// stages"). The vectors moved are labelled optimal. Each step costs a sparse factorisation over the
+// ends that move: at most kUntangleEnds of them and kUntangleSteps steps, else refused (a
+// voxelised stage's thousands of folds took minutes to refuse).
+constexpr int kUntangleRings = 10;
+constexpr Index kUntangleEnds = 5000;
+constexpr int kUntangleSteps = 40;
+
+std::optional<DisplacementField3> untangled(DisplacementField3 field, const Work& call, const detail::FoldTest& test) {
+  const Surface& s1 = call.user.source;
+  const Surface& s2 = call.user.target;
+  const FacesRef faces = field.faces;
+  // The ends that move: the folded triangles' corners and kUntangleRings rings around them.
+  std::vector<char> free(static_cast<std::size_t>(field.size()), 0);
+  const std::vector<char> folded = test.folded(field.ends);
+  for (Index f = 0; f < faces.rows(); ++f) {
+    if (folded[static_cast<std::size_t>(f)])
+      for (int i = 0; i < 3; ++i) free[static_cast<std::size_t>(faces(f, i))] = 1;
+  }
+  for (int ring = 0; ring < kUntangleRings; ++ring) {
+    std::vector<char> grown = free;
+    for (Index f = 0; f < faces.rows(); ++f) {
+      if (free[static_cast<std::size_t>(faces(f, 0))] || free[static_cast<std::size_t>(faces(f, 1))] ||
+          free[static_cast<std::size_t>(faces(f, 2))])
+        for (int i = 0; i < 3; ++i) grown[static_cast<std::size_t>(faces(f, i))] = 1;
+    }
+    free = std::move(grown);
+  }
+  if (std::count(free.begin(), free.end(), 1) > kUntangleEnds) return std::nullopt;
+  // The triangles touching them, over their own numbering of the ends.
+  std::vector<Index> local(static_cast<std::size_t>(field.size()), -1), rows;
+  std::vector<Index> kept;
+  for (Index f = 0; f < faces.rows(); ++f) {
+    if (!(free[static_cast<std::size_t>(faces(f, 0))] || free[static_cast<std::size_t>(faces(f, 1))] ||
+          free[static_cast<std::size_t>(faces(f, 2))]))
+      continue;
+    kept.push_back(f);
+    for (int i = 0; i < 3; ++i) {
+      Index& at = local[static_cast<std::size_t>(faces(f, i))];
+      if (at < 0) at = static_cast<Index>(rows.size()), rows.push_back(faces(f, i));
+    }
+  }
+  const Index count = static_cast<Index>(rows.size());
+  Points3 starts(count, 3), ends(count, 3);
+  Faces part(static_cast<Index>(kept.size()), 3);
+  detail::EvenOptions options;
+  options.until_unfolded = true;
+  options.max_iterations = kUntangleSteps;
+  options.fixed.resize(static_cast<std::size_t>(count));
+  for (Index k = 0; k < count; ++k) {
+    starts.row(k) = field.starts.row(rows[static_cast<std::size_t>(k)]);
+    ends.row(k) = field.ends.row(rows[static_cast<std::size_t>(k)]);
+    options.fixed[static_cast<std::size_t>(k)] =
+        free[static_cast<std::size_t>(rows[static_cast<std::size_t>(k)])] ? 0 : 1;
+  }
+  for (std::size_t k = 0; k < kept.size(); ++k) {
+    for (int i = 0; i < 3; ++i) part(static_cast<Index>(k), i) = local[static_cast<std::size_t>(faces(kept[k], i))];
+  }
+  const detail::FoldTest part_test(starts, part, s1.vertices, s1.faces, *call.user_source, s2.vertices, s2.faces,
+                                   *call.user_target);
+  const double alpha = detail::surface_area(s2.vertices, s2.faces) / detail::surface_area(s1.vertices, s1.faces);
+  const Points3 moved =
+      detail::even_ends(starts, ends, part, part_test, s2.vertices, s2.faces, *call.user_target, alpha, options);
+  for (Index k = 0; k < count; ++k) field.ends.row(rows[static_cast<std::size_t>(k)]) = moved.row(k);
+  if (!defects(field, test).none()) return std::nullopt;
+  for (Index v = 0; v < field.size(); ++v) {
+    if (free[static_cast<std::size_t>(v)]) field.methods[static_cast<std::size_t>(v)] = Method::optimal;
+  }
+  return field;
+}
+
 // "auto": one vector per vertex of S1, every one mapped and no triangle folded, or GeometryError.
 // Tried in turn, the first such field returned: normal mapping; between nested surfaces, the
 // normal field with diffusion near where it failed (local_diffusion.hpp); reverse diffusion
 // carried onto S1's vertices (the paper's choice where normal mapping fails); diffusion; minimal
-// distance; reverse normal mapping and reverse minimal distance, carried. Diffusion's lost
-// streamlines are filled and its turned slivers repaired within each. `outer`: where this runs
+// distance; reverse normal mapping and reverse minimal distance, carried; then the complete one
+// with the fewest folds, untangled. Diffusion's lost streamlines are filled and its turned slivers
+// repaired within each. `outer`: where this runs
 // the other way round (reverse), the call's own work pair: each candidate is carried onto its S1
 // and judged there.
 DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diffusion, const Work* outer = nullptr) {
@@ -262,6 +337,13 @@ DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diff
   const Defects normal_defects = defects(normal_answer, test);
   if (normal_defects.none()) return normal_answer;
   std::vector<std::pair<std::string, Defects>> tried{{"normal", normal_defects}};
+  // The complete candidate with the fewest folded triangles, for the last resort.
+  std::optional<DisplacementField3> least;
+  Index least_folded = 0;
+  const auto keep = [&](const DisplacementField3& field, const Defects& found) {
+    if (found.unmapped == 0 && (!least || found.folded < least_folded)) least = field, least_folded = found.folded;
+  };
+  keep(normal_answer, normal_defects);
   // Diffusion needs a region between the surfaces; where one of them encloses no volume the
   // attempts would be refused (require_volume), so they are not made.
   const bool diffusable = detail::encloses_volume(source.volume, source.vertices) &&
@@ -298,6 +380,7 @@ DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diff
           return *smoothed;
       }
       tried.emplace_back(name, found);
+      keep(field, found);
     } catch (const GeometryError& error) {
       tried.emplace_back(std::string(name) + " (" + error.what() + ")", Defects{-1, -1});
     } catch (const InvalidInput& error) {
@@ -310,6 +393,7 @@ DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diff
   const Defects nearest_defects = defects(nearest, test);
   if (nearest_defects.none()) return nearest;
   tried.emplace_back("minimal distance", nearest_defects);
+  keep(nearest, nearest_defects);
   for (const MapMethod method : {MapMethod::normal, MapMethod::minimal_distance}) {
     DisplacementField3 back = outer != nullptr ? basic(method, outer->user, *outer->user_target, diffusion)
                                                : carried(basic(method, pair.swapped(), source_index, diffusion), pair,
@@ -317,6 +401,12 @@ DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diff
     const Defects found = defects(back, test);
     if (found.none()) return back;
     tried.emplace_back(method == MapMethod::normal ? "reverse normal" : "reverse minimal distance", found);
+    keep(back, found);
+  }
+  if (least) {
+    if (diffusion.on_stage) diffusion.on_stage("untangle");
+    if (std::optional<DisplacementField3> field = untangled(std::move(*least), call, test)) return *field;
+    tried.emplace_back("the least folded of these moved along s2 to unfold", Defects{-1, -1});
   }
   std::string message = "map_surfaces: no complete, fold-free field from the " + std::to_string(s1.vertices.rows()) +
                         " vertices of s1 to s2 (";
