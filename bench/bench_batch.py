@@ -9,9 +9,12 @@ round runs the loop (`run_job` on each pair in this process, one after the other
 threads on every core) and then `map_batch` on the same pairs into another folder (its cluster's
 start and close, the workers' imports, the input hashes and the sidecars included). This process
 has morphomap, trimesh and SciPy imported before the loop starts; the workers import them in the
-batch's time. Prints each round and the median and range of the speed-up, with the machine's load
-(1-minute average) before and after each round: with other work on the 2 cores the batch cannot
-show its speed-up, so rerun on a loaded machine. Target: at least 1.7x on 2 cores.
+batch's time. Then the machine's own ceiling for the same work: two bare Python processes started
+together, each running every other pair with its core's threads on its share of the cores (no
+Dask, no hashes, no sidecars). Prints each round and the median and range of the speed-up and
+of that ceiling, with the machine's load (1-minute average) before and after each round: with
+other work on the 2 cores the batch cannot show its speed-up, so run it on an idle machine.
+Target: at least 1.7x on 2 cores.
 """
 
 from __future__ import annotations
@@ -20,6 +23,8 @@ import argparse
 import os
 import shutil
 import statistics
+import subprocess
+import sys
 import tempfile
 import time
 
@@ -27,6 +32,7 @@ import numpy as np
 import trimesh
 
 import morphomap as mm
+from morphomap import _core
 from morphomap.batch import Job, map_batch, run_job
 
 
@@ -45,7 +51,25 @@ def make_pairs(folder: str, pairs: int, subdivisions: int) -> list:
     return [(paths[2 * k], paths[2 * k + 1]) for k in range(pairs)]
 
 
-def one_round(folder: str, pairs: list, method: str, workers: int, number: int) -> dict:
+def bare_part(folder: str, part: int, parts: int, method: str, subdivisions: int, count: int) -> None:
+    """One of the bare processes: every ``parts``-th pair from ``part`` on, threads on its share."""
+    _core.limit_threads(max(1, (os.cpu_count() or 1) // parts))
+    for k, (a, b) in enumerate(make_pairs(folder, count, subdivisions)):
+        if k % parts == part:
+            run_job(Job(a, b, os.path.join(folder, f"bare{part}_{k:02d}.csv"), method))
+
+
+def bare_processes(folder: str, parts: int, method: str, subdivisions: int, count: int) -> float:
+    start = time.perf_counter()
+    children = [subprocess.Popen([sys.executable, __file__, "--bare-part", str(part), "--folder", folder,
+                                  "--workers", str(parts), "--method", method, "--subdivisions",
+                                  str(subdivisions), "--pairs", str(count)]) for part in range(parts)]
+    if any(child.wait() != 0 for child in children):
+        raise RuntimeError("a bare process failed")
+    return time.perf_counter() - start
+
+
+def one_round(folder: str, pairs: list, method: str, workers: int, number: int, subdivisions: int) -> dict:
     jobs = {kind: [Job(a, b, os.path.join(folder, f"{kind}{number}_{k:02d}.csv"), method)
                    for k, (a, b) in enumerate(pairs)] for kind in ("loop", "batch")}
     before = load()
@@ -58,7 +82,8 @@ def one_round(folder: str, pairs: list, method: str, workers: int, number: int) 
     batch = time.perf_counter() - start
     difference = max((np.abs(mm.read_field(a.output).ends - mm.read_field(b.output).ends).max()
                       for a, b in zip(jobs["loop"], jobs["batch"]) if os.path.exists(b.output)), default=np.nan)
-    return {"loop": loop, "batch": batch, "failed": sum(r.status != "done" for r in results),
+    bare = bare_processes(folder, workers, method, subdivisions, len(pairs))
+    return {"loop": loop, "batch": batch, "bare": bare, "failed": sum(r.status != "done" for r in results),
             "job": statistics.median(r.seconds for r in results if r.status == "done"),
             "difference": difference, "load": (before, load())}
 
@@ -72,7 +97,12 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--method", default="diffusion")
+    parser.add_argument("--bare-part", type=int, help=argparse.SUPPRESS)
+    parser.add_argument("--folder", help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.bare_part is not None:
+        bare_part(args.folder, args.bare_part, args.workers, args.method, args.subdivisions, args.pairs)
+        return
     if args.quick:
         args.pairs, args.subdivisions, args.rounds = 4, 3, 1
     folder = tempfile.mkdtemp(prefix="bench_batch_")
@@ -81,18 +111,22 @@ def main() -> None:
         faces = len(trimesh.creation.icosphere(args.subdivisions).faces)
         print(f"morphomap {mm.__version__}, {os.cpu_count()} cores; {args.pairs} pairs of {faces:,} faces, "
               f"{args.method}, {args.workers} workers")
-        print("\n| round | loop s | map_batch s | speed-up | median job s in a worker | failed "
-              "| largest end difference | load before, after |")
-        print("|---:|---:|---:|---:|---:|---:|---:|---|")
+        print("\n| round | loop s | map_batch s | speed-up | bare processes s | ceiling | median job s in a "
+              "worker | failed | largest end difference | load before, after |")
+        print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")
         rounds = []
         for number in range(args.rounds):
-            r = one_round(folder, pairs, args.method, args.workers, number)
+            r = one_round(folder, pairs, args.method, args.workers, number, args.subdivisions)
             rounds.append(r)
             print(f"| {number + 1} | {r['loop']:.2f} | {r['batch']:.2f} | {r['loop'] / r['batch']:.2f}x "
+                  f"| {r['bare']:.2f} | {r['loop'] / r['bare']:.2f}x "
                   f"| {r['job']:.2f} | {r['failed']} | {r['difference']:.2g} "
                   f"| {r['load'][0]:.1f}, {r['load'][1]:.1f} |", flush=True)
         ups = [r["loop"] / r["batch"] for r in rounds]
-        print(f"\nspeed-up median {statistics.median(ups):.2f}x, range {min(ups):.2f}-{max(ups):.2f}x; loop median "
+        tops = [r["loop"] / r["bare"] for r in rounds]
+        print(f"\nceiling (bare processes) median {statistics.median(tops):.2f}x, "
+              f"range {min(tops):.2f}-{max(tops):.2f}x")
+        print(f"speed-up median {statistics.median(ups):.2f}x, range {min(ups):.2f}-{max(ups):.2f}x; loop median "
               f"{statistics.median(r['loop'] for r in rounds):.2f} s, map_batch median "
               f"{statistics.median(r['batch'] for r in rounds):.2f} s")
     finally:
