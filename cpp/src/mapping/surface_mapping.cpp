@@ -313,9 +313,8 @@ std::optional<DisplacementField3> untangled(DisplacementField3 field, const Work
 // carried onto S1's vertices (the paper's choice where normal mapping fails); diffusion; minimal
 // distance; reverse normal mapping and reverse minimal distance, carried; then the complete one
 // with the fewest folds, untangled. Diffusion's lost streamlines are filled and its turned slivers
-// repaired within each. `outer`: where this runs
-// the other way round (reverse), the call's own work pair: each candidate is carried onto its S1
-// and judged there.
+// repaired within each. `outer`: where this runs the other way round (reverse), the call's own
+// work pair: each candidate is carried onto its S1 and judged there.
 DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diffusion, const Work* outer = nullptr) {
   const Pair& pair = work.user;
   const Surface& source = pair.source;
@@ -406,7 +405,7 @@ DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diff
   if (least) {
     if (diffusion.on_stage) diffusion.on_stage("untangle");
     if (std::optional<DisplacementField3> field = untangled(std::move(*least), call, test)) return *field;
-    tried.emplace_back("the least folded of these moved along s2 to unfold", Defects{-1, -1});
+    tried.emplace_back("the least folded of these, its ends moved along s2: folds remain", Defects{-1, -1});
   }
   std::string message = "map_surfaces: no complete, fold-free field from the " + std::to_string(s1.vertices.rows()) +
                         " vertices of s1 to s2 (";
