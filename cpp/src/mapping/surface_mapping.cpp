@@ -233,6 +233,12 @@ std::optional<DisplacementField3> smoothed_over_folds(const DisplacementField3& 
   return std::nullopt;
 }
 
+// area(S2) / area(S1): the factor even_ends holds every triangle's area to.
+double area_ratio(const Pair& pair) {
+  return detail::surface_area(pair.target.vertices, pair.target.faces) /
+         detail::surface_area(pair.source.vertices, pair.source.faces);
+}
+
 // The last resort of "auto": a complete candidate's ends around its folded triangles (within
 // kUntangleRings edges of them) moved along S2 by even_ends, which turns folded triangles back
 // while it evens the areas, the ends beyond held; kept only where no triangle is left folded (limb
@@ -249,22 +255,10 @@ std::optional<DisplacementField3> untangled(DisplacementField3 field, const Work
   const Surface& s2 = call.user.target;
   const FacesRef faces = field.faces;
   // The ends that move: the folded triangles' corners and kUntangleRings rings around them.
+  const std::vector<Index> moving = detail::rows_near(field, test.folded(field.ends), kUntangleRings);
+  if (static_cast<Index>(moving.size()) > kUntangleEnds) return std::nullopt;
   std::vector<char> free(static_cast<std::size_t>(field.size()), 0);
-  const std::vector<char> folded = test.folded(field.ends);
-  for (Index f = 0; f < faces.rows(); ++f) {
-    if (folded[static_cast<std::size_t>(f)])
-      for (int i = 0; i < 3; ++i) free[static_cast<std::size_t>(faces(f, i))] = 1;
-  }
-  for (int ring = 0; ring < kUntangleRings; ++ring) {
-    std::vector<char> grown = free;
-    for (Index f = 0; f < faces.rows(); ++f) {
-      if (free[static_cast<std::size_t>(faces(f, 0))] || free[static_cast<std::size_t>(faces(f, 1))] ||
-          free[static_cast<std::size_t>(faces(f, 2))])
-        for (int i = 0; i < 3; ++i) grown[static_cast<std::size_t>(faces(f, i))] = 1;
-    }
-    free = std::move(grown);
-  }
-  if (std::count(free.begin(), free.end(), 1) > kUntangleEnds) return std::nullopt;
+  for (const Index v : moving) free[static_cast<std::size_t>(v)] = 1;
   // The triangles touching them, over their own numbering of the ends.
   std::vector<Index> local(static_cast<std::size_t>(field.size()), -1), rows;
   std::vector<Index> kept;
@@ -296,14 +290,11 @@ std::optional<DisplacementField3> untangled(DisplacementField3 field, const Work
   }
   const detail::FoldTest part_test(starts, part, s1.vertices, s1.faces, *call.user_source, s2.vertices, s2.faces,
                                    *call.user_target);
-  const double alpha = detail::surface_area(s2.vertices, s2.faces) / detail::surface_area(s1.vertices, s1.faces);
-  const Points3 moved =
-      detail::even_ends(starts, ends, part, part_test, s2.vertices, s2.faces, *call.user_target, alpha, options);
+  const Points3 moved = detail::even_ends(starts, ends, part, part_test, s2.vertices, s2.faces, *call.user_target,
+                                          area_ratio(call.user), options);
   for (Index k = 0; k < count; ++k) field.ends.row(rows[static_cast<std::size_t>(k)]) = moved.row(k);
   if (!defects(field, test).none()) return std::nullopt;
-  for (Index v = 0; v < field.size(); ++v) {
-    if (free[static_cast<std::size_t>(v)]) field.methods[static_cast<std::size_t>(v)] = Method::optimal;
-  }
+  for (const Index v : moving) field.methods[static_cast<std::size_t>(v)] = Method::optimal;
   return field;
 }
 
@@ -437,8 +428,8 @@ DisplacementField3 evened(DisplacementField3 field, const Pair& user, const Shel
   if (diffusion.on_stage) diffusion.on_stage("optimal");
   const detail::FoldTest test(s1.vertices, s1.faces, s1.vertices, s1.faces, *s1.index, s2.vertices, s2.faces,
                               *s2.index);
-  const double alpha = detail::surface_area(s2.vertices, s2.faces) / detail::surface_area(s1.vertices, s1.faces);
-  field.ends = detail::even_ends(field.starts, field.ends, field.faces, test, s2.vertices, s2.faces, *s2.index, alpha);
+  field.ends = detail::even_ends(field.starts, field.ends, field.faces, test, s2.vertices, s2.faces, *s2.index,
+                                 area_ratio(user));
   std::fill(field.methods.begin(), field.methods.end(), Method::optimal);
   return field;
 }
