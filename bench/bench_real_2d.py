@@ -2,6 +2,7 @@
 
     PYTHONPATH=build/dev-NAME/pkg python3 bench/bench_real_2d.py               (from the repository root)
     PYTHONPATH=build/dev-NAME/pkg python3 bench/bench_real_2d.py --all-pairs   (every consecutive, 4 h, 8 h pair)
+    PYTHONPATH=build/dev-NAME/pkg python3 bench/bench_real_2d.py --dense       (10^3-10^4 points per curve)
     PYTHONPATH=build/dev-NAME/pkg python3 bench/bench_real_2d.py --cells       (best on cell-sized pixel contours)
 
 1. One table over chosen real pairs (consecutive hours, 4 h and 8 h apart, the long jumps 250->270
@@ -11,7 +12,10 @@
    default's QM over best's.
 2. With ``--all-pairs``: the default over every pair the tests map, closed and open: how many pairs
    have crossings or misses, the largest QM ratio to ``optimal``, the median and largest time.
-3. With ``--cells``: ``best`` and the default on six consecutive frames of a migrating cell (a
+3. With ``--dense``: the kidney and limb 330->381 h (closed and open) resampled evenly to 10^3,
+   2 x 10^3 and 10^4 points per curve: the default's seconds, QM and the labels it kept, and
+   ``optimal``'s seconds and QM both ways (``reverse=True``), one run each.
+4. With ``--cells``: ``best`` and the default on six consecutive frames of a migrating cell (a
    blob with a turning protrusion, drifting 6 px per frame), contoured from its pixel mask as it
    is (``smooth=0``: the staircase, ~335 points, as a tracking tool's outline): seconds, QM and
    the winning candidate. Needs no shared data.
@@ -96,6 +100,35 @@ def all_pairs():
             print("   ", line)
 
 
+def dense():
+    rows = [("pair", "points", "default s", "default QM", "kept", "optimal s", "optimal QM", "reverse s",
+             "reverse QM")]
+    kidney = mm.load_example("kidney")
+    cases = [("kidney", *kidney, True)]
+    for closed in (True, False):
+        c1, c2 = (mm.make_simple(outline(h), closed=closed)[0] for h in (330, 381))
+        cases.append((f"limb 330->381 h {'closed' if closed else 'open'}", c1, c2, closed))
+    for name, a, b, closed in cases:
+        for n in (1000, 2000, 10_000):
+            c1, c2 = mm.resample(a, n, closed=closed), mm.resample(b, n, closed=closed)
+            cells = [name, str(n)]
+            for method, reverse in (("auto", False), ("optimal", False), ("optimal", True)):
+                begin = time.perf_counter()
+                try:
+                    field = mm.map_curves(c1, c2, method, closed=closed, reverse=reverse)
+                except (ValueError, RuntimeError) as error:
+                    cells += [f"{time.perf_counter() - begin:.2f}", f"raises: {str(error)[:40]}"]
+                    cells += [""] if method == "auto" else []
+                    continue
+                seconds = time.perf_counter() - begin
+                q = mm.quality(field, c1, c2, closed=closed)
+                cells += [f"{seconds:.2f}", f"{q.qm:.3g}" + (f" ({q.crossings} crossings)" if q.crossings else "")]
+                if method == "auto":
+                    cells.append(", ".join(sorted(set(map(str, field.method)))))
+            rows.append(tuple(cells))
+    print_table(rows)
+
+
 def cell_mask(frame, shape=(160, 200)):
     """A migrating cell at one frame: a lobed blob whose protrusion turns, drifting right."""
     rows, columns = np.mgrid[0:shape[0], 0:shape[1]].astype(float)
@@ -131,10 +164,11 @@ def print_table(rows):
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--all-pairs", action="store_true", help="the default over every pair the tests map")
+    parser.add_argument("--dense", action="store_true", help="the default and optimal at 10^3-10^4 points per curve")
     parser.add_argument("--cells", action="store_true", help="best on cell-sized pixel contours (no shared data)")
     args = parser.parse_args()
     if args.cells:
         raise SystemExit(cells())
     if not LIMB.is_dir():
         raise SystemExit(f"the limb-bud outlines are not beside the project ({LIMB.name} missing)")
-    all_pairs() if args.all_pairs else table()
+    dense() if args.dense else all_pairs() if args.all_pairs else table()

@@ -94,12 +94,21 @@ def test_fingers_up_to_six_long_map_without_crossings():
         check_order_preserving(mm.map_curves(c1, c2, "optimal"), c1, c2)
 
 
+def test_fingers_of_any_length_map_through_a_forced_jump():
+    # From 8 long, the few start points facing the finger cannot reach its tip within a step's
+    # reach with vectors inside the region; where every vector inside it is out of reach, the DP
+    # takes the jump from the furthest vectors of the row before (solve_level in optimal.cpp).
+    for depth in (8.0, 20.0, 40.0):
+        c1, c2 = budded(depth)
+        check_order_preserving(mm.map_curves(c1, c2, "optimal"), c1, c2)
+
+
 def test_no_crossing_free_matching_is_refused():
-    # A finger 8 long: the few start points facing it cannot reach its tip with vectors inside the
-    # region (each step advances a bounded stretch of C2).
-    c1, c2 = budded(8.0)
+    # Open curves run opposite ways: their end vectors, fixed, cross each other.
+    c1 = np.array([[0.0, 0.0], [0.5, 0.0], [1.0, 0.0]])
+    c2 = np.array([[1.0, 1.0], [0.5, 1.2], [0.0, 1.0]])
     with pytest.raises(mm.GeometryError, match="no crossing-free order-preserving matching"):
-        mm.map_curves(c1, c2, "optimal")
+        mm.map_curves(c1, c2, "optimal", closed=False)
 
 
 def test_a_start_a_hair_from_a_long_edge_end_lands_beside_it():

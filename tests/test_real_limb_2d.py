@@ -95,6 +95,29 @@ def test_optimal_maps_every_pair_without_crossings(closed):
     assert not failures, f"{len(failures)} of {len(pairs())} pairs: " + "; ".join(failures[:10])
 
 
+@pytest.mark.parametrize("closed", [True, False], ids=["closed", "open"])
+def test_the_lobed_jump_resampled_to_10_4_points(closed):
+    # 330 -> 381 h resampled evenly: where the source turns into a lobe, the part of C2 its points
+    # see from inside the region jumps ahead by more than a step's reach, and the bands of the
+    # finer levels must follow the coarse path's jumps; optimal raised from 10^3 points on. Now
+    # optimal, its reverse and the default map crossing-free at every density (time:
+    # bench/README.md "Real 2D outlines").
+    require_limb()
+    a, b = (mm.make_simple(outline(h), closed=closed)[0] for h in (330, 381))
+    for n in (1000, 2000, 10_000):
+        c1, c2 = mm.resample(a, n, closed=closed), mm.resample(b, n, closed=closed)
+        for method, reverse in (("optimal", False), ("optimal", True), ("auto", False)):
+            field = mm.map_curves(c1, c2, method, closed=closed, reverse=reverse)
+            q = mm.quality(field, c1, c2, closed=closed)
+            assert field.valid.all(), (n, method, reverse)
+            assert q.crossings == 0, (n, method, reverse)
+            size = np.ptp(np.vstack([c1, c2]), axis=0).max()
+            assert mm.closest_points(field.starts, c1, closed=closed).distances.max() < 1e-9 * size
+            assert mm.closest_points(field.ends, c2, closed=closed).distances.max() < 1e-9 * size
+            if not reverse:  # every point of C1 a start
+                assert mm.closest_points(c1, field.starts, closed=closed).distances.max() < 1e-12 * size
+
+
 def test_optimal_on_the_flank_is_as_even_as_normal_mapping():
     # 300 -> 301 h closed: the curves cross on the flank segment; optimal's QM stays within twice
     # normal mapping's (its samples include the uniform map's position of every start).

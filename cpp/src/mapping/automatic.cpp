@@ -7,8 +7,10 @@
 #include "common/run_both.hpp"
 #include "common/validation.hpp"
 #include "curves/arc_curve.hpp"
+#include "curves/crossing_sweep.hpp"
 #include "curves/unchecked.hpp"
 #include "mapping/curve_job.hpp"
+#include "quality/checked_quality.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -49,7 +51,7 @@ Vectors paper_algorithm(const Job& job, const std::vector<double>& start_keys, c
       settings.density_threshold > 0.0 && point_density(job, start_points(job)) > settings.density_threshold
           ? reverse(MapMethod::minimal_distance, job, whole_source, whole_source_index, settings)
           : forward(MapMethod::normal, job, start_keys, settings);
-  if (complete(first) && count_crossings(first.starts, first.ends) == 0) return first;
+  if (complete(first) && !any_crossing(first.starts, first.ends)) return first;
   for (const bool backwards : {true, false}) {
     try {
       Vectors v = backwards ? reverse(MapMethod::diffusion, job, whole_source, whole_source_index, settings)
@@ -71,13 +73,20 @@ namespace {
 // this is kept (the real pairs' best fields have QM 1e-4 to 0.4; bench/README.md, "Real 2D
 // outlines"); above it the tenth of a second diffusion costs is worth spending.
 constexpr double kGoodEnough = 1.0;
+// ... judged on the field thinned to at most this many vectors, the density of the outlines that
+// set kGoodEnough: where one step of the source fans out over an arc of the target, that step's
+// share of QM1 and QM2 grows with the square of the points per curve, so the same fan measures
+// QM 0.28 at 200 points and 5 at 10^4 (limb 330->381 h, bench/README.md "Real 2D outlines"), and
+// diffusion, seconds at that density, would run for a field no worse than at 200.
+constexpr Index kJudged = 200;
 
 // One candidate of the default on one job, measured on the job's piece as best.py measures a piece:
 // its vectors with the meetings' own at the piece's ends.
 struct Scored {
   Vectors vectors;
-  Index crossings = 0, misses = 0;
+  Index misses = 0;
   double qm = std::numeric_limits<double>::infinity();  // NaN measures rank last
+  double judged = qm;                                   // QM thinned to kJudged vectors
   std::string failure;                                  // why it is not admissible ("" when it is)
 };
 
@@ -95,14 +104,29 @@ Scored measured(const Job& job, Vectors v) {
     f.ends.row(m + b) = job.target.row(job.target.rows() - 1);
   }
   for (Index i = 0; i < m; ++i) s.misses += v.ends.row(i).allFinite() ? 0 : 1;
-  s.crossings = count_crossings(f.starts, f.ends);
   if (s.misses > 0) s.failure = std::to_string(s.misses) + " misses";
-  if (s.crossings > 0) s.failure += (s.failure.empty() ? "" : ", ") + std::to_string(s.crossings) + " crossing pairs";
-  if (s.failure.empty()) {
+  if (any_crossing(f.starts, f.ends)) s.failure += (s.failure.empty() ? "" : ", ") + std::string("crossings");
+  auto qm_of = [&](const DisplacementField2& field) {
     try {
-      const double qm = quality(f, job.source, job.target, job.source_closed).qm;
-      if (std::isfinite(qm)) s.qm = qm;
+      const double qm =
+          checked_quality(field, job.source, source_index(job), job.target, target_index(job), job.source_closed, false)
+              .qm;
+      if (std::isfinite(qm)) return qm;
     } catch (const InvalidInput&) {  // a piece too degenerate to measure (a target shrunk to a point)
+    }
+    return std::numeric_limits<double>::infinity();
+  };
+  if (s.failure.empty()) {
+    s.qm = s.judged = qm_of(f);
+    if (m > kJudged) {
+      const Index stride = (m + kJudged - 1) / kJudged;
+      std::vector<Index> rows;
+      if (b) rows.push_back(0);
+      for (Index i = 0; i < m; i += stride) rows.push_back(b + i);
+      if (e) rows.push_back(m + b);
+      DisplacementField2 thinned;
+      thinned.starts = f.starts(rows, Eigen::all), thinned.ends = f.ends(rows, Eigen::all);
+      s.judged = qm_of(thinned);
     }
   }
   s.vectors = std::move(v);
@@ -229,7 +253,7 @@ Vectors default_choice(const Job& job, const std::vector<double>& start_keys, co
   consider(attempt("minimal_distance", plain(MapMethod::minimal_distance)));
   consider(attempt("reverse_minimal_distance", backwards(MapMethod::minimal_distance)));
   consider(attempt("reverse_optimal", backwards(MapMethod::optimal)));
-  if (!best.failure.empty() || !(best.qm <= kGoodEnough)) {
+  if (!best.failure.empty() || !(best.judged <= kGoodEnough)) {
     consider(attempt("diffusion", plain(MapMethod::diffusion)));
     consider(attempt("reverse_diffusion", backwards(MapMethod::diffusion)));
   }
@@ -275,7 +299,8 @@ void keep_points_of(DisplacementField2& field, const Points2Ref& curve, double t
 
 double field_qm(const DisplacementField2& field, const Points2Ref& c1, const Points2Ref& c2, bool closed) {
   try {
-    const double qm = quality(field, c1, c2, closed).qm;
+    const double qm =
+        checked_quality(field, c1, Unchecked::build(c1, closed), c2, Unchecked::build(c2, closed), closed, false).qm;
     return std::isfinite(qm) ? qm : std::numeric_limits<double>::infinity();
   } catch (const InvalidInput&) {
     return std::numeric_limits<double>::infinity();
@@ -326,7 +351,7 @@ DisplacementField2 mapped_choice(const Points2Ref& c1, Index n1, const CurveInde
       DisplacementField2 field = mapped_pair(c1, n1, index1, c2, n2, index2, options, &similarity);
       const double size = (p1.colwise().maxCoeff() - p1.colwise().minCoeff()).norm();
       keep_points_of(field, p1, 1e-9 * size);
-      if (field.starts.allFinite() && field.ends.allFinite() && crossing_pairs(field.starts, field.ends).empty()) {
+      if (field.starts.allFinite() && field.ends.allFinite() && !any_crossing(field.starts, field.ends)) {
         moved = std::move(field);
       }
     } catch (const GeometryError&) {  // the moved pair has no crossing-free field: the plain one stands

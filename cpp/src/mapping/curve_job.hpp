@@ -36,6 +36,13 @@ struct Job {
   mutable std::shared_ptr<const CurveIndex> source_index, target_index;
 };
 
+inline const CurveIndex& source_index(const Job& job) {
+  if (!job.source_index) {
+    job.source_index = std::make_shared<const CurveIndex>(CurveIndexUnchecked::build(job.source, job.source_closed));
+  }
+  return *job.source_index;
+}
+
 inline const CurveIndex& target_index(const Job& job) {
   if (!job.target_index) {
     job.target_index = std::make_shared<const CurveIndex>(CurveIndexUnchecked::build(job.target, job.target_closed));

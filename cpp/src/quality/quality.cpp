@@ -6,6 +6,7 @@
 #include "common/validation.hpp"
 #include "curves/arc_curve.hpp"
 #include "curves/unchecked.hpp"
+#include "quality/checked_quality.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -121,10 +122,10 @@ void require_as_many_ends(const DisplacementField2& field) {
   }
 }
 
-// quality after its checks: c1 and c2 passed require_curve, index1 and index2 are built from them
-// as given.
-CurveQuality checked_quality(const DisplacementField2& field, const Points2Ref& c1, const CurveIndex& index1,
-                             const Points2Ref& c2, const CurveIndex& index2, bool closed) {
+}  // namespace
+
+CurveQuality detail::checked_quality(const DisplacementField2& field, const Points2Ref& c1, const CurveIndex& index1,
+                                     const Points2Ref& c2, const CurveIndex& index2, bool closed, bool with_crossings) {
   const Index m = field.size();
   const ArcCurve curve1 = ArcCurve::unchecked(c1, closed);
   const ArcCurve curve2 = ArcCurve::unchecked(c2, closed);
@@ -182,25 +183,23 @@ CurveQuality checked_quality(const DisplacementField2& field, const Points2Ref& 
     q.qm2 = kNaN;
   }
   q.qm = q.qm1 * q.qm2;
-  q.crossings = count_crossings(field.starts, field.ends);
+  q.crossings = with_crossings ? count_crossings(field.starts, field.ends) : 0;
   return q;
 }
-
-}  // namespace
 
 CurveQuality quality(const DisplacementField2& field, const Points2Ref& c1, const Points2Ref& c2, bool closed) {
   require_as_many_ends(field);
   detail::require_curve(c1, closed, "c1");
   detail::require_curve(c2, closed, "c2");
-  return checked_quality(field, c1, detail::CurveIndexUnchecked::build(c1, closed), c2,
-                         detail::CurveIndexUnchecked::build(c2, closed), closed);
+  return detail::checked_quality(field, c1, detail::CurveIndexUnchecked::build(c1, closed), c2,
+                                 detail::CurveIndexUnchecked::build(c2, closed), closed);
 }
 
 CurveQuality quality(const DisplacementField2& field, const PreparedCurve& c1, const PreparedCurve& c2, bool closed) {
   require_as_many_ends(field);
   c1.require_closed(closed, "c1");
   c2.require_closed(closed, "c2");
-  return checked_quality(field, c1.points(), c1.index(), c2.points(), c2.index(), closed);
+  return detail::checked_quality(field, c1.points(), c1.index(), c2.points(), c2.index(), closed);
 }
 
 }  // namespace morphomap
