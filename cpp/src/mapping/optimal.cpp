@@ -33,12 +33,12 @@ using detail::MatchProblem;
 using detail::MatchRegion;
 constexpr Index kThinning = 4;  // starts per level
 // The full grid (every sample for every start, about 5 R^2 cells for R starts, each a line query
-// with the region) is searched for at most kCoarsest starts: the 200-point outlines keep the exact
-// optimum. Larger problems are thinned down to kCoarsestLevel starts, as a full grid of 256 rows
-// outweighed all finer levels together (limb 330->381 h at 10^4 points closed: the default 1.7 ->
-// 1.2 s; bench/README.md "Real 2D outlines").
-constexpr Index kCoarsest = 256;
-constexpr Index kCoarsestLevel = 64;
+// with the region) is searched for at most kCoarsest starts; larger problems are thinned level by
+// level down to that. A full grid of 256 rows outweighed all finer levels together: at 10^4 points
+// the default went 1.7 -> 1.2 s (limb 330->381 h closed), on the 200-point outlines its slowest
+// pairs 0.22 -> 0.15 s, every one of their QMs unchanged with kSmallMatch's margins
+// (bench/README.md "Real 2D outlines").
+constexpr Index kCoarsest = 64;
 // A target with an edge longer than this many times its median edge is sampled through its
 // vertices as well as evenly (sample_arcs).
 constexpr double kUneven = 4.0;
@@ -174,7 +174,7 @@ MonotoneMatch detail::monotone_match_unchecked(const Points2Ref& source, const s
   // The levels, finest first: every kThinning-th start of the level below (the pinned ends kept).
   std::vector<std::vector<Index>> levels{std::vector<Index>(n)};
   for (Index r = 0; r < n; ++r) levels[0][r] = r;
-  while (n > kCoarsest && static_cast<Index>(levels.back().size()) > kCoarsestLevel) {
+  while (static_cast<Index>(levels.back().size()) > kCoarsest) {
     const std::vector<Index>& below = levels.back();
     std::vector<Index> rows;
     for (std::size_t r = 0; r < below.size(); r += kThinning) rows.push_back(below[r]);
@@ -234,12 +234,12 @@ MonotoneMatch detail::monotone_match_unchecked(const Points2Ref& source, const s
     crossings = take(true);
   }
   match.by_construction = inside && why_not.empty() && crossings == 0;
-  if (inside && crossings == 0 && jumped && levels.size() == 1) {
+  if (inside && crossings == 0 && jumped && n <= detail::kSmallMatch) {
     // A forced jump is one long stretch; the penalised matching, whose vectors may leave the
     // region a little, may still be crossing-free and spread it (limb 252->256 h open, mapped
     // back: QM 0.0036 with the jump, 0.00028 without). The lower energy without crossings wins.
-    // Only on one level: on the limb and kidney pairs resampled to 10^3-10^4 points it won none of
-    // 9 tries (its vectors cross by the hundred there) and doubled optimal's time.
+    // Only on small problems: on the limb and kidney pairs resampled to 10^3-10^4 points it won
+    // none of 9 tries (its vectors cross by the hundred there) and doubled optimal's time.
     MatchProblem loose = p;
     loose.region = nullptr;
     std::vector<double> kept_t = coarse_t;

@@ -304,8 +304,9 @@ bool solve_levels(const MatchProblem& p, const std::vector<std::vector<Index>>& 
     level.samples = static_cast<Index>(level.arcs.size()) - 1;
     const std::vector<std::pair<double, double>> bracket =
         coarse_rows.empty() ? std::vector<std::pair<double, double>>() : carry(p, coarse_rows, coarse_t, level.rows);
-    // Beyond the bracket, a margin of two starts' worth of samples, doubled where no path is found.
-    const Index first_band = std::max<Index>(8, 2 * level.samples / (count + 1));
+    // Beyond the bracket, a margin of some starts' worth of samples, doubled where no path is found.
+    const Index margin = n <= kSmallMatch ? 8 : 2;
+    const Index first_band = std::max<Index>(8, margin * level.samples / (count + 1));
     Index band = first_band;
     bool constrained = p.region != nullptr;
     std::vector<Index> path;

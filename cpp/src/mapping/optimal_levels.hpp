@@ -10,6 +10,11 @@
 
 namespace morphomap::detail {
 
+// Matchings of at most this many starts (outlines as traced, ~200 points) are worth more search:
+// each finer level's band reaches 8 starts' worth of samples beyond the coarse path (2 above), and
+// a path through a forced jump is compared with the one found without the region.
+constexpr Index kSmallMatch = 256;
+
 // The problem of one call: start points with their arc positions, the two pieces' lengths, the
 // virtual vectors at both ends, and the weights.
 struct MatchProblem {
