@@ -37,7 +37,7 @@ constexpr Index kThinning = 4;  // starts per level
 // level down to that. A full grid of 256 rows outweighed all finer levels together: at 10^4 points
 // the default went 1.7 -> 1.2 s (limb 330->381 h closed), on the 200-point outlines its slowest
 // pairs 0.22 -> 0.15 s, every one of their QMs unchanged with kSmallMatch's margins
-// (bench/README.md "Real 2D outlines").
+// (bench/README.md "Real 2D outlines", before widened bands reused their cells).
 constexpr Index kCoarsest = 64;
 // A target with an edge longer than this many times its median edge is sampled through its
 // vertices as well as evenly (sample_arcs).

@@ -112,25 +112,39 @@ std::vector<Vec2> target_samples(const MatchProblem& p, const Level& level) {
   return q;
 }
 
-// Fills level.admitted from the region: one query per cell of the band. A pinned row's vector is
-// a side of the region itself and always admitted.
-void admit(const MatchProblem& p, const std::vector<Index>& source_rows, Level& level) {
+// Fills level.admitted from the region: one query per cell of the band, but for the cells the
+// same level's narrower band (`before`, where a band is widened) answered already. A pinned row's
+// vector is a side of the region itself and always admitted.
+void admit(const MatchProblem& p, const std::vector<Index>& source_rows, Level& level, const Level* before) {
   const Index count = static_cast<Index>(level.rows.size());
   const std::vector<Vec2> q = target_samples(p, level);
   level.first.assign(count, 0);
   Index cells = 0;
   for (Index r = 0; r < count; ++r) level.first[r] = cells, cells += std::max<Index>(0, level.hi[r] - level.lo[r] + 1);
-  std::vector<Index> rows(cells), segments(cells);
-  Points2 ends(cells, 2);
+  level.admitted.assign(cells, 0);
+  std::vector<std::pair<Index, Index>> asked;  // (row, sample) of each cell to query
+  asked.reserve(cells);
   for (Index r = 0; r < count; ++r) {
     for (Index k = level.lo[r]; k <= level.hi[r]; ++k) {
-      const Index c = level.first[r] + k - level.lo[r];
-      rows[c] = source_rows[level.rows[r]];
-      ends.row(c) = q[k].transpose();
-      segments[c] = p.target->segment_at(level.arcs[k]);
+      if (before != nullptr && before->lo[r] <= k && k <= before->hi[r]) {
+        level.admitted[level.first[r] + k - level.lo[r]] = before->admitted[before->first[r] + k - before->lo[r]];
+      } else {
+        asked.emplace_back(r, k);
+      }
     }
   }
-  level.admitted = p.region->admits(rows, ends, segments);
+  const Index m = static_cast<Index>(asked.size());
+  std::vector<Index> rows(m), segments(m);
+  Points2 ends(m, 2);
+  for (Index a = 0; a < m; ++a) {
+    const auto [r, k] = asked[a];
+    rows[a] = source_rows[level.rows[r]];
+    ends.row(a) = q[k].transpose();
+    segments[a] = p.target->segment_at(level.arcs[k]);
+  }
+  const std::vector<char> answers = p.region->admits(rows, ends, segments);
+  for (Index a = 0; a < m; ++a)
+    level.admitted[level.first[asked[a].first] + asked[a].second - level.lo[asked[a].first]] = answers[a];
   for (Index r = 0; r < count; ++r) {
     const bool pinned = (r == 0 && p.pinned_first) || (r == count - 1 && p.pinned_last);
     if (pinned && level.hi[r] >= level.lo[r]) level.admitted[level.first[r]] = 1;
@@ -310,7 +324,9 @@ bool solve_levels(const MatchProblem& p, const std::vector<std::vector<Index>>& 
     Index band = first_band;
     bool constrained = p.region != nullptr;
     std::vector<Index> path;
+    Level before;  // the last constrained attempt at this level, whose answers a wider band reuses
     for (;;) {
+      if (constrained && !level.admitted.empty()) before = level;
       level.lo.resize(count), level.hi.resize(count);
       for (Index r = 0; r < count; ++r) {
         auto [lo, hi] = feasible(p, r, count, level.samples);
@@ -321,7 +337,7 @@ bool solve_levels(const MatchProblem& p, const std::vector<std::vector<Index>>& 
         level.lo[r] = lo, level.hi[r] = hi;
       }
       if (constrained) {
-        admit(p, start_rows, level);
+        admit(p, start_rows, level, before.admitted.empty() ? nullptr : &before);
       } else {
         level.admitted.clear();
       }
