@@ -33,8 +33,10 @@ std::vector<Pair> pairs_of(const std::vector<Segment>& segments) {
   }
   const std::vector<Pair> pairs = crossing_pairs(a, b);
   CHECK(count_crossings(a, b) == static_cast<Index>(pairs.size()));
-  // Small inputs are answered by the box search; the sweep must agree.
+  // Small inputs are answered by the box search; the sweep must agree, and so must the test that
+  // stops at the first crossing.
   CHECK(morphomap::detail::crossing_pairs_by_sweep(a, b) == pairs);
+  CHECK(morphomap::detail::any_crossing(a, b) == !pairs.empty());
   return pairs;
 }
 

@@ -76,8 +76,9 @@ constexpr double kGoodEnough = 1.0;
 // ... judged on the field thinned to at most this many vectors, the density of the outlines that
 // set kGoodEnough: where one step of the source fans out over an arc of the target, that step's
 // share of QM1 and QM2 grows with the square of the points per curve, so the same fan measures
-// QM 0.28 at 200 points and 5 at 10^4 (limb 330->381 h, bench/README.md "Real 2D outlines"), and
-// diffusion, seconds at that density, would run for a field no worse than at 200.
+// QM 0.28 at 200 points and 4.3 at 10^4 (optimal on limb 330->381 h open, bench/README.md "Real 2D
+// outlines"). Unthinned, the diffusion candidates (seconds each at 10^4 points) would run for a
+// field as good as one kept at 200.
 constexpr Index kJudged = 200;
 
 // One candidate of the default on one job, measured on the job's piece as best.py measures a piece:

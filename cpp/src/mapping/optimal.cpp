@@ -216,7 +216,7 @@ MonotoneMatch detail::monotone_match_unchecked(const Points2Ref& source, const s
 
   // With the region: crossing-free by construction where it is a simple polygon (or the cut ring);
   // where it is not, its vectors are still the likeliest to be free of crossings. Without a path
-  // inside it, the penalised one. Every result is counted exactly (the line queries round at 1e-9
+  // inside it, the penalised one. Every result is checked exactly (the line queries round at 1e-9
   // of a vector's length) and returned only without crossings.
   const bool free_rows = n > static_cast<Index>(p.pinned_first) + static_cast<Index>(p.pinned_last);
   std::unique_ptr<MatchRegion> region;
