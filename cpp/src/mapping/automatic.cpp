@@ -298,10 +298,11 @@ void keep_points_of(DisplacementField2& field, const Points2Ref& curve, double t
   field.methods = std::move(methods);
 }
 
-double field_qm(const DisplacementField2& field, const Points2Ref& c1, const Points2Ref& c2, bool closed) {
+// QM of a field the caller found crossing-free, on C1 and C2 with their indexes.
+double field_qm(const DisplacementField2& field, const Points2Ref& c1, const CurveIndex& index1, const Points2Ref& c2,
+                const CurveIndex& index2, bool closed) {
   try {
-    const double qm =
-        checked_quality(field, c1, Unchecked::build(c1, closed), c2, Unchecked::build(c2, closed), closed, false).qm;
+    const double qm = checked_quality(field, c1, index1, c2, index2, closed, false).qm;
     return std::isfinite(qm) ? qm : std::numeric_limits<double>::infinity();
   } catch (const InvalidInput&) {
     return std::numeric_limits<double>::infinity();
@@ -366,8 +367,10 @@ DisplacementField2 mapped_choice(const Points2Ref& c1, Index n1, const CurveInde
   }
   if (!plain) return std::move(*moved);
   const Points2Ref a = c1.topRows(n1), b = c2.topRows(n2);
-  return field_qm(*moved, a, b, options.closed) < field_qm(*plain, a, b, options.closed) ? std::move(*moved)
-                                                                                         : std::move(*plain);
+  const CurveIndex ia = Unchecked::build(a, options.closed), ib = Unchecked::build(b, options.closed);
+  return field_qm(*moved, a, ia, b, ib, options.closed) < field_qm(*plain, a, ia, b, ib, options.closed)
+             ? std::move(*moved)
+             : std::move(*plain);
 }
 
 }  // namespace morphomap::detail

@@ -36,18 +36,18 @@ struct Job {
   mutable std::shared_ptr<const CurveIndex> source_index, target_index;
 };
 
+// A job's index of one of its curves, built into `slot` on first use.
+inline const CurveIndex& built_index(std::shared_ptr<const CurveIndex>& slot, const Points2& curve, bool closed) {
+  if (!slot) slot = std::make_shared<const CurveIndex>(CurveIndexUnchecked::build(curve, closed));
+  return *slot;
+}
+
 inline const CurveIndex& source_index(const Job& job) {
-  if (!job.source_index) {
-    job.source_index = std::make_shared<const CurveIndex>(CurveIndexUnchecked::build(job.source, job.source_closed));
-  }
-  return *job.source_index;
+  return built_index(job.source_index, job.source, job.source_closed);
 }
 
 inline const CurveIndex& target_index(const Job& job) {
-  if (!job.target_index) {
-    job.target_index = std::make_shared<const CurveIndex>(CurveIndexUnchecked::build(job.target, job.target_closed));
-  }
-  return *job.target_index;
+  return built_index(job.target_index, job.target, job.target_closed);
 }
 
 // Vectors with the arc position of their start along the whole source curve, to order them.

@@ -34,10 +34,9 @@ using detail::MatchRegion;
 constexpr Index kThinning = 4;  // starts per level
 // The full grid (every sample for every start, about 5 R^2 cells for R starts, each a line query
 // with the region) is searched for at most kCoarsest starts; larger problems are thinned level by
-// level down to that. A full grid of 256 rows outweighed all finer levels together: at 10^4 points
-// the default went 1.7 -> 1.2 s (limb 330->381 h closed), on the 200-point outlines its slowest
-// pairs 0.22 -> 0.15 s, every one of their QMs unchanged with kSmallMatch's margins
-// (bench/README.md "Real 2D outlines", before widened bands reused their cells).
+// level down to that. A full grid of 256 rows outweighed all finer levels together (the default on
+// limb 330->381 h closed at 10^4 points: 1.7 s with it, 1.2 s without), and with kSmallMatch's
+// margins the 200-point outlines keep every QM (bench/README.md "Real 2D outlines").
 constexpr Index kCoarsest = 64;
 // A target with an edge longer than this many times its median edge is sampled through its
 // vertices as well as evenly (sample_arcs).
@@ -196,10 +195,11 @@ MonotoneMatch detail::monotone_match_unchecked(const Points2Ref& source, const s
   std::vector<Index> virtual_rows;
   if (!p.pinned_first) virtual_rows.push_back(-1);
   if (!p.pinned_last && !one_vector) virtual_rows.push_back(n);
-  // The path's ends and an exact count of its crossings, or (exact false) 1 where it has any.
+  // The path's ends into match (fill), and an exact count of their crossings, or (exact false) 1
+  // where they have any (take).
   std::vector<double> coarse_t;
   double energy = 0.0;
-  auto take = [&](bool exact) -> Index {
+  auto fill = [&] {
     for (Index r = 0; r < n; ++r) {
       match.arcs[r] = coarse_t[r];
       match.points.row(r) = curve.point_at(coarse_t[r]).transpose();
@@ -207,6 +207,9 @@ MonotoneMatch detail::monotone_match_unchecked(const Points2Ref& source, const s
     if (p.pinned_first) match.points.row(0) = p.begin_target.transpose();
     if (p.pinned_last) match.points.row(n - 1) = p.end_target.transpose();
     match.energy = energy;
+  };
+  auto take = [&](bool exact) -> Index {
+    fill();
     Points2 ends(starts.rows(), 2);
     ends.topRows(n) = match.points;
     for (std::size_t e = 0; e < to.size(); ++e) ends.row(n + static_cast<Index>(e)) = to[e].transpose();
@@ -240,13 +243,12 @@ MonotoneMatch detail::monotone_match_unchecked(const Points2Ref& source, const s
     // back: QM 0.0036 with the jump, 0.00028 without). The lower energy without crossings wins.
     // Only on small problems: on the limb and kidney pairs resampled to 10^3-10^4 points it won
     // none of 9 tries (its vectors cross by the hundred there) and doubled optimal's time.
-    MatchProblem loose = p;
-    loose.region = nullptr;
+    p.region = nullptr;  // not needed again: this path is crossing-free either way
     std::vector<double> kept_t = coarse_t;
     const double kept_energy = energy;
     bool ignored = false;
     try {
-      solve_levels(loose, levels, finest, start_rows, coarse_t, energy, ignored);
+      solve_levels(p, levels, finest, start_rows, coarse_t, energy, ignored);
     } catch (const GeometryError&) {
       energy = kInf;
     }
@@ -254,7 +256,7 @@ MonotoneMatch detail::monotone_match_unchecked(const Points2Ref& source, const s
       match.by_construction = false;
     } else {
       coarse_t = std::move(kept_t), energy = kept_energy;
-      take(false);
+      fill();
     }
   }
   if (free_rows && (!inside || crossings > 0)) {
