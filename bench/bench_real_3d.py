@@ -7,11 +7,13 @@ the flank), as given (coarse, closed by flat caps of long thin triangles) and re
 stage's median edge length (``remesh_surface``): for the default (``auto``) and ``diffusion``,
 the vectors (one per vertex of S1), valid ones, folded triangles, QM and seconds (one run each),
 or the error's first words where the call raised. Then the stages voxelised at 12 units on one
-grid and contoured by ``surface_from_mask`` (18k / 68k / 123k faces): the default on four pairs.
+grid and contoured by ``surface_from_mask`` (18k / 68k / 123k faces, ``tests/limb_stages.py``):
+both methods on four pairs.
 """
 
 from __future__ import annotations
 
+import sys
 import time
 import warnings
 from pathlib import Path
@@ -20,23 +22,13 @@ import numpy as np
 
 import morphomap as mm
 
-STAGES = Path(__file__).resolve().parents[1].parent / "shared" / "cases" / "limb-bud" / "3d"
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests"))
+from limb_stages import voxelised  # noqa: E402
+
+STAGES = ROOT.parent / "shared" / "cases" / "limb-bud" / "3d"
 PAIRS = ((250, 270), (270, 250), (270, 290), (290, 270), (250, 290), (290, 250))
 METHODS = ("auto", "diffusion")
-
-
-def voxelised(stages, pitch=12.0):
-    """Each stage filled on one grid of ``pitch`` and contoured back: a mask as a lab would have it."""
-    low = np.min([s.bounds[0] for s in stages.values()], axis=0) - 2 * pitch
-    out = {}
-    for hour, surface in stages.items():
-        index = np.round((surface.voxelized(pitch=pitch).fill().points - low) / pitch).astype(int)
-        mask = np.zeros(tuple(index.max(0)[::-1] + 3), bool)  # (z, y, x)
-        mask[index[:, 2], index[:, 1], index[:, 0]] = True
-        contoured = mm.surface_from_mask(mask, (pitch, pitch, pitch))
-        contoured.apply_translation(low)
-        out[hour] = contoured
-    return out
 
 
 def row(label, a, b, method, s1, s2):
@@ -70,7 +62,8 @@ def main():
                 row(label, a, b, method, s1, s2)
     masks = voxelised(given)
     for a, b in ((270, 290), (290, 270), (250, 270), (270, 250)):
-        row("voxels", a, b, "auto", masks[a], masks[b])
+        for method in METHODS:
+            row("voxels", a, b, method, masks[a], masks[b])
 
 if __name__ == "__main__":
     main()

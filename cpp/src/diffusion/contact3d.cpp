@@ -150,12 +150,21 @@ ClearedSource clear_contact(const Points3Ref& source_vertices, const FacesRef& s
       refuse(touching_faces, tolerance, "and lies within " + std::to_string(clearance) + " of it everywhere");
     }
     // A ring on both sides: the surfaces cross around this patch, which the crossing region's
-    // corefinement handles where they do not also coincide.
+    // corefinement handles, cutting out where they coincide (CrossingRegion). A lone vertex on the
+    // target there (frames contoured on one grid share the marching-cubes planes) makes the faces
+    // around it share slivers of those planes with the target: cut out, they leave the pieces
+    // pinched to points, on which Mesh_3 crashed in every attempt (the voxelised limb stages,
+    // bench/README.md, "Real 3D stages"). Lifted off by the tolerance, such a vertex still maps to
+    // its closest point; the corners of faces that lie on the target stay.
     const double side_share =
         static_cast<double>(std::max(ring_inside, ring_outside)) / static_cast<double>(ring_inside + ring_outside);
     if (side_share < 0.75) {
-      if (!has_touching_face) continue;
-      refuse(touching_faces, tolerance, "where they also cross");
+      for (const Index v : patch) {
+        if (!cleared.touching[v] || on_touching_face[v]) continue;
+        cleared.vertices.row(v) += tolerance * normals.row(v);
+        ++cleared.moved;
+      }
+      continue;
     }
     // Away from the target, on the patch's side: along the source normals, turned to agree with
     // the way from the target's surface into that side. The surfaces face the same way along the

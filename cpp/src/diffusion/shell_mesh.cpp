@@ -405,6 +405,7 @@ struct CrossingRegion::Patches {
   std::vector<SurfaceMesh> meshes;  // the patches
   std::vector<char> from_source;    // the patch is part of S1 (else of S2)
   std::vector<char> inside_other;   // it lies inside the other surface
+  std::vector<char> coincident;     // it lies on the other surface, both facing the same way
   std::vector<char> has_border;     // it ends at a crossing curve (a patch without one is a
                                     // whole component of a surface that the other does not cut)
   double volume = 0.0;
@@ -476,19 +477,31 @@ CrossingRegion::CrossingRegion(const ClosedSurface& source_surface, const Closed
     for (std::size_t k = 0; k < p.meshes.size(); ++k) {
       const SurfaceMesh& mesh = p.meshes[k];
       Point centroid;
+      std::array<Point, 3> largest_face;
       double largest = -1.0;
       for (const auto f : mesh.faces()) {
         std::array<Point, 3> q;
         int i = 0;
         for (const auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) q[i++] = mesh.point(v);
         const double area = CGAL::squared_area(q[0], q[1], q[2]);
-        if (area > largest) largest = area, centroid = CGAL::centroid(q[0], q[1], q[2]);
+        if (area > largest) largest = area, centroid = CGAL::centroid(q[0], q[1], q[2]), largest_face = q;
       }
-      const CGAL::Bounded_side side = p.from_source[k] ? in_target(centroid) : in_source(centroid);
-      if (side == CGAL::ON_BOUNDARY) {
-        throw InvalidInput("s2: coincides with s1 over a patch; the region between them is not a volume there");
-      }
+      const auto& other_side = p.from_source[k] ? in_target : in_source;
+      const CGAL::Bounded_side side = other_side(centroid);
       p.inside_other.push_back(side == CGAL::ON_BOUNDED_SIDE ? 1 : 0);
+      p.coincident.push_back(side == CGAL::ON_BOUNDARY ? 1 : 0);
+      if (side != CGAL::ON_BOUNDARY) continue;
+      // Which way the other surface faces there: a step off the face along its outward normal,
+      // a thousandth of the face's size, lands outside the other surface where both face the
+      // same way (frames contoured on one grid where the tissue did not move: the patch bounds
+      // no piece, as the paper's curves meet at a shared stretch), inside where they face each
+      // other (bodies pressed together, whose pieces would share the patch as S1 and as S2).
+      const Kernel::Vector_3 normal = CGAL::unit_normal(largest_face[0], largest_face[1], largest_face[2]);
+      if (other_side(centroid + 1e-3 * std::sqrt(largest) * normal) == CGAL::ON_BOUNDED_SIDE) {
+        throw InvalidInput(
+            "s2: presses against s1 from outside over a patch; the region between them is not a "
+            "volume there");
+      }
     }
   } catch (const CGAL::Failure_exception& e) {
     throw GeometryError(std::string("cutting the surfaces where they cross failed: ") + e.what());
@@ -496,8 +509,10 @@ CrossingRegion::CrossingRegion(const ClosedSurface& source_surface, const Closed
 
   // S1 \ S2 is bounded by the parts of S1 outside S2 (outwards) and of S2 inside S1 (inwards),
   // S2 \ S1 likewise: the pieces' volume is the sum over the outside patches minus the inside ones.
+  // A coincident patch bounds neither piece (both are empty on either side of it).
   const Point origin = CGAL::centroid(p.source.points().begin(), p.source.points().end());
   for (std::size_t k = 0; k < p.meshes.size(); ++k) {
+    if (p.coincident[k]) continue;
     const double volume = signed_volume(p.meshes[k], origin);
     p.volume += p.inside_other[k] ? -volume : volume;
   }
@@ -510,17 +525,23 @@ double CrossingRegion::volume() const { return patches_->volume; }
 ShellMesh CrossingRegion::mesh(const ShellMeshCriteria& criteria) const {
   const Patches& p = *patches_;
   C3t3 c3t3;
+  std::vector<int> patch_of;  // the Domain's patch index (from 1) -> index in p.meshes
   try {
     // (subdomain inside, subdomain outside) of each patch: S1 \ S2 is 1, S2 \ S1 is 2, the
-    // intersection and the outside of both are 0 (not meshed).
+    // intersection and the outside of both are 0 (not meshed). Coincident patches bound neither.
     std::vector<std::pair<int, int>> sides;
+    std::vector<const SurfaceMesh*> kept;
     for (std::size_t k = 0; k < p.meshes.size(); ++k) {
+      if (p.coincident[k]) continue;
       const int piece_inside = p.from_source[k] ? 1 : 2, piece_outside = p.from_source[k] ? 2 : 1;
       sides.push_back(p.inside_other[k] ? std::make_pair(0, piece_outside) : std::make_pair(piece_inside, 0));
+      kept.push_back(&p.meshes[k]);
+      patch_of.push_back(static_cast<int>(k));
     }
     const Sizing sizing(p.source, p.target, criteria);
     CGAL::Random random(criteria.seed);
-    const Domain domain(p.meshes.begin(), p.meshes.end(), sides.begin(), sides.end(), &random);
+    const Domain domain(boost::make_indirect_iterator(kept.begin()), boost::make_indirect_iterator(kept.end()),
+                        sides.begin(), sides.end(), &random);
     namespace params = CGAL::parameters;
     // First the crossing curves, protected by balls of the local size, and a coarse mesh; then
     // the few vertices of any patch no curve bounds (Mesh_3 may not find it by itself); then the
@@ -529,8 +550,8 @@ ShellMesh CrossingRegion::mesh(const ShellMeshCriteria& criteria) const {
                           params::facet_size = criteria.cell_size, params::cell_radius_edge_ratio = 3.0,
                           params::cell_size = criteria.cell_size);
     c3t3 = CGAL::make_mesh_3<C3t3>(domain, coarse, params::features(domain), params::no_perturb(), params::no_exude());
-    for (std::size_t k = 0; k < p.meshes.size(); ++k) {
-      if (!p.has_border[k]) seed_patch(c3t3, domain, p.meshes[k], static_cast<int>(k) + 1);
+    for (std::size_t i = 0; i < kept.size(); ++i) {
+      if (!p.has_border[patch_of[i]]) seed_patch(c3t3, domain, *kept[i], static_cast<int>(i) + 1);
     }
     const Criteria fine(params::edge_size = sizing, params::facet_angle = 25.0, params::facet_size = sizing,
                         params::facet_distance = criteria.facet_distance, params::cell_radius_edge_ratio = 3.0,
@@ -539,10 +560,10 @@ ShellMesh CrossingRegion::mesh(const ShellMeshCriteria& criteria) const {
   } catch (const CGAL::Failure_exception& e) {
     throw GeometryError(std::string("meshing the region between the surfaces failed: ") + e.what());
   }
-  const int count = static_cast<int>(p.meshes.size());
+  const int count = static_cast<int>(patch_of.size());
   return to_shell_mesh(c3t3, [&](int patch) {
     if (patch < 1 || patch > count) return other_face;
-    return p.from_source[patch - 1] ? source_face : target_face;
+    return p.from_source[patch_of[patch - 1]] ? source_face : target_face;
   });
 }
 

@@ -86,11 +86,13 @@ ShellMesh mesh_shell(const ClosedSurface& source, const ClosedSurface& target, b
 
 // The symmetric difference of two crossing closed surfaces: each surface cut along the curves
 // where they cross (CGAL's corefinement) into patches that lie inside or outside the other. The
-// pieces are S1 \ S2 (between the parts of S1 outside S2 and of S2 inside S1) and S2 \ S1.
+// pieces are S1 \ S2 (between the parts of S1 outside S2 and of S2 inside S1) and S2 \ S1. Where
+// the surfaces coincide, facing the same way, the pieces pinch to the patch's rim: it bounds neither.
 class CrossingRegion {
  public:
   // Both surfaces closed, consistently oriented outwards, free of self-intersections and crossing
-  // (classify_nesting). Throws InvalidInput if the two coincide over a patch.
+  // (classify_nesting). Throws InvalidInput if the two press against each other over a patch
+  // (coincide facing opposite ways).
   CrossingRegion(const ClosedSurface& source, const ClosedSurface& target);
   ~CrossingRegion();
   CrossingRegion(const CrossingRegion&) = delete;
