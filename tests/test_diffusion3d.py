@@ -187,31 +187,6 @@ def test_crossing_surfaces_reverse_is_inverse(crossing):
     assert np.sqrt(np.mean(error**2)) < 0.005 and error.max() < 0.012
 
 
-def test_crossing_boxes_that_share_faces():
-    """Two unit cubes, one shifted by half along x: they cross, and over x in [0, 0.5] their top,
-    bottom, front and back faces coincide. The coincident faces are cut out of the region as
-    contact (their vertices stay); S1 \\ S2 is the slab x in [-0.5, 0], which S1 bounds on five
-    sides and S2 by its face x = 0, so every streamline from S1's face x = -0.5 ends on that face;
-    S2 \\ S1 is the slab x in [0.5, 1], into which S1's face x = 0.5 maps."""
-    cube = trimesh.creation.box((1.0, 1.0, 1.0))
-    shifted = trimesh.creation.box((1.0, 1.0, 1.0))
-    shifted.apply_translation((0.5, 0.0, 0.0))
-    for _ in range(3):
-        cube, shifted = cube.subdivide(), shifted.subdivide()
-    field = mm.map_surfaces(cube, shifted, "diffusion")
-    v, ends = cube.vertices, field.ends
-    assert field.valid.all() and mm.quality(field, cube, shifted).folds == 0
-    shared = (np.isclose(np.abs(v[:, 1]), 0.5) | np.isclose(np.abs(v[:, 2]), 0.5)) & (v[:, 0] > 1e-9)
-    np.testing.assert_allclose(ends[shared], v[shared], atol=1e-9)
-    back = np.isclose(v[:, 0], -0.5)
-    np.testing.assert_allclose(ends[back, 0], 0.0, atol=1e-9)
-    assert np.all(np.abs(ends[back, 1:]) < 0.5)  # inside the face, not on its rim
-    front = np.isclose(v[:, 0], 0.5) & np.all(np.abs(v[:, 1:]) < 0.5 - 1e-9, axis=1)
-    assert np.all(ends[front, 0] > 0.5) and np.all(ends[front, 0] <= 1.0 + 1e-9)
-    centre = np.argmin(np.linalg.norm(v - (0.5, 0.0, 0.0), axis=1))
-    np.testing.assert_allclose(ends[centre], (1.0, 0.0, 0.0), atol=0.02)
-
-
 def test_crossing_surfaces_bad_input():
     cube = trimesh.creation.box((1.0, 1.0, 1.0))
     shifted = trimesh.creation.box((1.0, 1.0, 1.0))

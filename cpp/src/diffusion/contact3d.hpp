@@ -29,9 +29,9 @@ struct ClearedSource {
 // the source's normals until it lies about `clearance` from the target, on the side of the target
 // where the patch's surroundings (its ring of farther vertices) lie. A patch whose surroundings lie
 // on both sides (it touches where the surfaces also cross) is left to the crossing region, its
-// vertices within `tolerance` of the target lifted off by `tolerance` unless they are corners of a
-// face within it (one the crossing region cuts out). A surface that lies within `clearance`
-// everywhere, with a face within `tolerance`: InvalidInput.
+// vertices within `tolerance` of the target lifted off by `tolerance`, unless it has a face
+// within `tolerance` at all three corners: then, as for a surface that lies within `clearance`
+// everywhere, InvalidInput.
 ClearedSource clear_contact(const Points3Ref& source_vertices, const FacesRef& source_faces,
                             const Points3Ref& target_vertices, const FacesRef& target_faces,
                             const ClosedSurface& target_surface, const SurfaceIndex& target_index, double clearance,
