@@ -214,6 +214,11 @@ class Child:
             self.err.close()
         self.err = tempfile.TemporaryFile()
         env = dict(os.environ, PYTHONFAULTHANDLER="1", PYTHONUNBUFFERED="1")
+        # The worker runs in this folder: a relative PYTHONPATH (``PYTHONPATH=python`` from the
+        # repository root) would miss the build under test and import an installed copy instead.
+        if env.get("PYTHONPATH"):
+            env["PYTHONPATH"] = os.pathsep.join(os.path.abspath(part) if part else part
+                                                for part in env["PYTHONPATH"].split(os.pathsep))
         self.proc = subprocess.Popen([sys.executable, str(WORKER), "--serve"], cwd=str(HERE), env=env,
                                      stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self.err)
         self.buffer = b""
