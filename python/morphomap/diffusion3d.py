@@ -63,9 +63,12 @@ def solve_diffusion_3d(s1, s2, *, mesh_size=None, streamlines=False, progress=No
         vertices of S1 within 1% of the finer mean edge of S2 map to their closest point there
         (``touching``), and those within half that edge are pulled back from S2 along S1's normals,
         to half an edge away on the side their surroundings lie, before the region is meshed
-        (their streamlines start there). Surfaces that lie apart or only touch from outside, or
-        a contact patch that also crosses S2 or that the pull-back would fold into itself, raise
-        ValueError;
+        (their streamlines start there). Where the surfaces also cross around such a patch, it
+        is left to the crossing region: its vertices on S2 are lifted off by that 1% (they still
+        map to their closest point), and a coincident patch left between the crossing curves is
+        cut out of both pieces. Surfaces that lie apart or only touch from outside, faces of S1
+        lying on S2 where the surfaces also cross, or a contact patch that the pull-back would
+        fold into itself, raise ValueError;
         ``map_surfaces(..., method="auto")`` falls back to normal mapping there.
     mesh_size : float, optional
         Largest tetrahedron size. Default: a quarter of the mean gap (the region's volume over the
