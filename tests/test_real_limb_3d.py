@@ -93,7 +93,7 @@ def test_diffusion_loses_no_streamline_on_the_stages(stages):
 def voxel_stages(stages):
     from limb_stages import voxelised
 
-    return voxelised({h: stages[h] for h in (270, 290)})
+    return voxelised(stages)  # all three on one grid, as bench_real_3d.py has them
 
 
 # Contoured on one grid, 270 and 290 h share marching-cubes planes where they cross: the shared
