@@ -151,12 +151,11 @@ ClearedSource clear_contact(const Points3Ref& source_vertices, const FacesRef& s
     }
     // A ring on both sides: the surfaces cross around this patch, which the crossing region's
     // corefinement handles. Where they also share faces, cutting those out of the region pinches
-    // its pieces to the faces' rims, on which Mesh_3 crashed in every attempt (11 of 13 such
-    // pairs of the 3D fuzz suite) or ran for minutes (one more): refused. A lone vertex on the
-    // target (frames contoured on one grid share the marching-cubes planes) makes the faces
-    // around it share slivers of those planes with the target, which pinch the pieces to points
-    // (Mesh_3 crashed in every attempt on the voxelised limb stages, bench/README.md, "Real 3D
-    // stages"): lifted off by the tolerance, it still maps to its closest point.
+    // its pieces to the faces' rims, on which Mesh_3 crashes or runs for minutes: refused. A lone
+    // vertex on the target (frames contoured on one grid share the marching-cubes planes) makes
+    // the faces around it share slivers of those planes with the target, which pinch the pieces
+    // to points: lifted off by the tolerance, it still maps to its closest point (both measured
+    // in bench/README.md, "Real 3D stages", contact where the surfaces cross).
     const double side_share =
         static_cast<double>(std::max(ring_inside, ring_outside)) / static_cast<double>(ring_inside + ring_outside);
     if (side_share < 0.75) {
