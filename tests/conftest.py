@@ -8,6 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from child_calls import ChildCalls
+
 
 def circle(n, radius=1.0, centre=(0.0, 0.0), clockwise=False):
     """n points on a circle, starting at angle 0."""
@@ -26,6 +28,14 @@ def ellipse(n, a, b, centre=(0.0, 0.0)):
 @pytest.fixture
 def rng():
     return np.random.default_rng(20141)
+
+
+@pytest.fixture(scope="module")
+def child():
+    """A child process that evaluates calls (child_calls.py): an abort there fails the test, not the run."""
+    calls = ChildCalls()
+    yield calls
+    calls.close()
 
 
 @pytest.fixture

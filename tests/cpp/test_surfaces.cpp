@@ -156,7 +156,7 @@ int main() {
     double best = std::numeric_limits<double>::infinity();
     const Index f = near.faces[i];
     CHECK(f >= 0);
-    // No vertex is nearer than the point found (tests/test_surfaces.py compares with brute force).
+    // No vertex is nearer than the point found (tests/test_surface_queries.py compares with brute force).
     for (Index v = 0; v < ellipsoid.vertices.rows(); ++v) {
       best = std::min(best, (ellipsoid.vertices.row(v) - origins.row(i)).norm());
     }
