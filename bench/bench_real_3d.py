@@ -61,7 +61,7 @@ def main():
             s1, s2 = stages[a], stages[b]
             for method in METHODS:
                 row(label, a, b, method, s1, s2)
-    for label, smooth in (("voxels", 0.0), ("smoothed", 12.0)):
+    for label, smooth in (("voxels", 0.0), ("blurred", 12.0)):
         masks = voxelised(given, smooth=smooth)
         for a, b in ((270, 290), (290, 270), (250, 270), (270, 250)):
             for method in METHODS:

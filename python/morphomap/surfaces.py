@@ -111,11 +111,17 @@ def map_surfaces(s1, s2, method="auto", *, reverse=False, mesh_size=None, repeat
         turn, the first such field returned: normal mapping; between nested surfaces the normal
         field with diffusion within two mean gaps of where it failed (its ends blended into the
         normal ones and put on ``s2``); reverse diffusion carried onto ``s1``'s vertices (the
-        paper's choice); diffusion; minimal distance; normal mapping and minimal distance from
-        ``s2``'s vertices, carried onto ``s1``'s. With ``reverse=True`` the same ways run from
-        ``s2``, each carried onto ``s1`` and judged there. A diffusion field with a few folded
-        triangles left has the ends around them (up to 4 edges away) re-placed by the harmonic
-        interpolation of the ends around, put on ``s2``, if that leaves no fold.
+        paper's choice; diffusion first where ``s2`` has fewer vertices); diffusion; the last
+        resort on the complete field with the fewest folded triangles so far; minimal distance;
+        normal mapping and minimal distance from ``s2``'s vertices, carried onto ``s1``'s; the
+        last resort on the least folded of all, where that is another. With ``reverse=True`` the
+        same ways run from ``s2``, each carried onto ``s1`` and judged there. A diffusion field
+        with a few folded triangles left has the ends around them (up to 4 edges away)
+        re-placed by the harmonic interpolation of the ends around, put on ``s2``, if that leaves
+        no fold. The last resort moves the ends within 10 edges of the folded triangles along
+        ``s2`` by the descent of ``"optimal"``, a folded triangle's area ratio counting negative,
+        until none is folded (at most 5,000 ends and 40 steps; those vectors are labelled
+        ``"optimal"``), else gives up.
         ``field.method`` says which way each vector came.
         ``"optimal"`` (beyond the paper): ``"auto"``'s field, then its ends moved along ``s2`` so
         that every triangle's image keeps its share of ``s2``'s area: E = sum_j (A'_j / (alpha
