@@ -10,6 +10,7 @@ import pytest
 
 import morphomap as mm
 from conftest import SHARED_CASES, require_cases
+from limb_stages import voxelised
 
 trimesh = pytest.importorskip("trimesh")
 
@@ -91,31 +92,28 @@ def test_diffusion_loses_no_streamline_on_the_stages(stages):
 
 @pytest.fixture(scope="module")
 def voxel_stages(stages):
-    from limb_stages import voxelised
-
     return voxelised(stages)  # all three on one grid, as bench_real_3d.py has them
 
 
 # Contoured on one grid, 270 and 290 h share marching-cubes planes where they cross: the shared
 # patches are cut out of the crossing region and lone vertices on S2 lifted off it (else Mesh_3
 # crashes on pieces pinched to points). Measured: complete, 157 and 49 folded triangles (0.23% and
-# 0.04% of the faces); the default finds no fold-free field there (bench/README.md "Real 3D
-# stages").
-@pytest.mark.parametrize("pair", [(270, 290), (290, 270)], ids=["270-290", "290-270"])
-def test_diffusion_maps_the_voxelised_crossing_stages(voxel_stages, pair):
+# 0.04% of the faces; bounded here at 0.3% and 0.06%); the default finds no fold-free field there
+# (bench/README.md "Real 3D stages").
+@pytest.mark.parametrize(("pair", "folded_share"), [((270, 290), 0.003), ((290, 270), 0.0006)],
+                         ids=["270-290", "290-270"])
+def test_diffusion_maps_the_voxelised_crossing_stages(voxel_stages, pair, folded_share):
     s1, s2 = voxel_stages[pair[0]], voxel_stages[pair[1]]
     field = mm.map_surfaces(s1, s2, "diffusion")
     np.testing.assert_array_equal(field.starts, s1.vertices)
     assert field.valid.all()
-    assert mm.quality(field, s1, s2).folds < 0.005 * len(s1.faces)
+    assert mm.quality(field, s1, s2).folds < folded_share * len(s1.faces)
     on_s2 = mm.SurfaceIndex(s2.vertices, s2.faces).closest_points(field.ends).distances
     assert on_s2.max() < 1e-6 * np.ptp(s2.vertices, axis=0).max()
 
 
 @pytest.fixture(scope="module")
 def blurred_voxel_stages(stages):
-    from limb_stages import voxelised
-
     return voxelised(stages, smooth=12.0)  # the masks blurred by one voxel: the issue's 63k / 114k faces
 
 
