@@ -1,6 +1,7 @@
 // The paper's 3D mapping: minimal distance, normal and diffusion mapping of the vertices of one
 // closed surface onto another, with reverse and "auto" (normal, else diffusion where it fails).
 #include <morphomap/laplace3d.hpp>
+#include <morphomap/remesh.hpp>
 #include <morphomap/surface_mapping.hpp>
 #include <morphomap/surface_queries.hpp>
 
@@ -9,9 +10,11 @@
 #include "common/validation.hpp"
 #include "diffusion/shell_diffusion.hpp"
 #include "diffusion/shell_mesh.hpp"
+#include "mapping/coarse_field.hpp"
 #include "mapping/even_surface.hpp"
 #include "mapping/local_diffusion.hpp"
 #include "mapping/surface_fields.hpp"
+#include "mapping/untangled_field.hpp"
 #include "quality/folds.hpp"
 #include "surfaces/refine.hpp"
 #include "surfaces/surface_util.hpp"
@@ -239,68 +242,10 @@ double area_ratio(const Pair& pair) {
          detail::surface_area(pair.source.vertices, pair.source.faces);
 }
 
-// The last resort of "auto": a complete candidate's ends around its folded triangles (within
-// kUntangleRings edges of them) moved along S2 by even_ends, which turns folded triangles back
-// while it evens the areas, the ends beyond held; kept only where no triangle is left folded (limb
-// bud 290 -> 250 h: every candidate folds 2-20 triangles at the tip; bench/README.md "Real 3D
-// stages"). The vectors moved are labelled optimal. Each step costs a sparse factorisation over the
-// ends that move: at most kUntangleEnds of them and kUntangleSteps steps, else refused (a
-// voxelised stage's thousands of folds took minutes to refuse).
-constexpr int kUntangleRings = 10;
-constexpr Index kUntangleEnds = 5000;
-constexpr int kUntangleSteps = 40;
-
-std::optional<DisplacementField3> untangled(DisplacementField3 field, const Work& call, const detail::FoldTest& test) {
-  const Surface& s1 = call.user.source;
-  const Surface& s2 = call.user.target;
-  const FacesRef faces = field.faces;
-  // The ends that move: the folded triangles' corners and kUntangleRings rings around them.
-  const std::vector<Index> moving = detail::rows_near(field, test.folded(field.ends), kUntangleRings);
-  if (static_cast<Index>(moving.size()) > kUntangleEnds) return std::nullopt;
-  std::vector<char> free(static_cast<std::size_t>(field.size()), 0);
-  for (const Index v : moving) free[static_cast<std::size_t>(v)] = 1;
-  // The triangles touching them, over their own numbering of the ends.
-  std::vector<Index> local(static_cast<std::size_t>(field.size()), -1), rows;
-  std::vector<Index> kept;
-  for (Index f = 0; f < faces.rows(); ++f) {
-    if (!(free[static_cast<std::size_t>(faces(f, 0))] || free[static_cast<std::size_t>(faces(f, 1))] ||
-          free[static_cast<std::size_t>(faces(f, 2))]))
-      continue;
-    kept.push_back(f);
-    for (int i = 0; i < 3; ++i) {
-      Index& at = local[static_cast<std::size_t>(faces(f, i))];
-      if (at < 0) at = static_cast<Index>(rows.size()), rows.push_back(faces(f, i));
-    }
-  }
-  const Index count = static_cast<Index>(rows.size());
-  Points3 starts(count, 3), ends(count, 3);
-  Faces part(static_cast<Index>(kept.size()), 3);
-  detail::EvenOptions options;
-  options.until_unfolded = true;
-  options.max_iterations = kUntangleSteps;
-  options.fixed.resize(static_cast<std::size_t>(count));
-  for (Index k = 0; k < count; ++k) {
-    starts.row(k) = field.starts.row(rows[static_cast<std::size_t>(k)]);
-    ends.row(k) = field.ends.row(rows[static_cast<std::size_t>(k)]);
-    options.fixed[static_cast<std::size_t>(k)] =
-        free[static_cast<std::size_t>(rows[static_cast<std::size_t>(k)])] ? 0 : 1;
-  }
-  for (std::size_t k = 0; k < kept.size(); ++k) {
-    for (int i = 0; i < 3; ++i) part(static_cast<Index>(k), i) = local[static_cast<std::size_t>(faces(kept[k], i))];
-  }
-  const detail::FoldTest part_test(starts, part, s1.vertices, s1.faces, *call.user_source, s2.vertices, s2.faces,
-                                   *call.user_target);
-  const Points3 moved = detail::even_ends(starts, ends, part, part_test, s2.vertices, s2.faces, *call.user_target,
-                                          area_ratio(call.user), options);
-  for (Index k = 0; k < count; ++k) field.ends.row(rows[static_cast<std::size_t>(k)]) = moved.row(k);
-  if (!defects(field, test).none()) return std::nullopt;
-  for (const Index v : moving) field.methods[static_cast<std::size_t>(v)] = Method::optimal;
-  return field;
-}
-
 // "auto": one vector per vertex of S1, every one mapped and no triangle folded, or GeometryError.
 // Tried in turn, the first such field returned: normal mapping; between nested surfaces, the
-// normal field with diffusion near where it failed (local_diffusion.hpp); reverse diffusion
+// normal field with diffusion near where it failed (local_diffusion.hpp); where S1 is large and
+// `coarsen`, auto on coarse copies of the pair carried back (coarse_field.hpp); reverse diffusion
 // carried onto S1's vertices (the paper's choice where normal mapping fails) and diffusion, in
 // that order unless S2 has fewer vertices than S1; the complete one with the fewest folds so far,
 // untangled; minimal distance; reverse normal mapping and reverse minimal distance, carried; then
@@ -308,7 +253,10 @@ std::optional<DisplacementField3> untangled(DisplacementField3 field, const Work
 // Diffusion's lost streamlines are filled and its turned slivers repaired within each. `outer`:
 // where this runs the other way round (reverse), the call's own work pair: each candidate is
 // carried onto its S1 and judged there.
-DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diffusion, const Work* outer = nullptr) {
+DisplacementField3 checked(Surface s1, Surface s2, const SurfaceMappingOptions& options, bool coarsen);
+
+DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diffusion, const Work* outer = nullptr,
+                             bool coarsen = true) {
   const Pair& pair = work.user;
   const Surface& source = pair.source;
   const Surface& target = pair.target;
@@ -342,7 +290,9 @@ DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diff
   const auto last_resort = [&]() -> std::optional<DisplacementField3> {
     if (!least || least_tried) return std::nullopt;
     if (diffusion.on_stage) diffusion.on_stage("untangle");
-    if (std::optional<DisplacementField3> field = untangled(*least, call, test)) return field;
+    if (std::optional<DisplacementField3> field = detail::untangled(*least, test, s1.vertices, s1.faces, *call.user_source,
+                                                                    s2.vertices, s2.faces, *call.user_target))
+      return field;
     least_tried = true;
     tried.emplace_back("the least folded of these, its ends moved along s2: folds remain", Defects{-1, -1});
     return std::nullopt;
@@ -367,6 +317,36 @@ DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diff
       }
     } catch (const GeometryError&) {
     } catch (const InvalidInput&) {  // surfaces whose region diffusion cannot mesh (they coincide in part, say)
+    }
+  }
+  // A large S1 (thousands of small triangles, contoured from voxels) through coarse copies of the
+  // pair: auto on copies remeshed at about kCoarseVertices vertices of S1, carried back. The
+  // blurred voxel limb 270 -> 290 h maps so in 8 s, where every whole-resolution candidate folded
+  // (bench/README.md "Real 3D stages"). Not reversed: that call's S1 is the other surface.
+  if (coarsen && outer == nullptr && diffusable && detail::worth_coarsening(s1.vertices)) {
+    const double edge = detail::coarse_edge(s1.vertices, s1.faces);
+    const std::string name = "auto on copies remeshed at edge length " + std::to_string(edge);
+    try {
+      TriangleSurface c1, c2;
+      detail::run_both([&] { c1 = remesh_surface(s1.vertices, s1.faces, edge, detail::kCoarseRemeshing); },
+                       [&] { c2 = remesh_surface(s2.vertices, s2.faces, edge, detail::kCoarseRemeshing); });
+      SurfaceMappingOptions options;
+      options.diffusion_repeatable = diffusion.repeatable;
+      options.on_stage = diffusion.on_stage;
+      const DisplacementField3 coarse =
+          checked(Surface{c1.vertices, c1.faces, check_closed_surface(c1.vertices, c1.faces, "coarse copy of s1")},
+                  Surface{c2.vertices, c2.faces, check_closed_surface(c2.vertices, c2.faces, "coarse copy of s2")},
+                  options, false);
+      DisplacementField3 field = detail::carried_from_coarse(coarse, s1.vertices, s1.faces, *call.user_source,
+                                                             s2.vertices, s2.faces, *call.user_target);
+      const Defects found = defects(field, test);
+      if (found.none()) return field;
+      tried.emplace_back(name + ", carried", found);
+      keep(field, found);
+    } catch (const GeometryError&) {  // its own message lists the coarse copies' candidates
+      tried.emplace_back(name + ": no complete, fold-free field there either", Defects{-1, -1});
+    } catch (const InvalidInput& error) {  // a copy remeshed into a surface that is not closed and outward
+      tried.emplace_back(name + " (" + error.what() + ")", Defects{-1, -1});
     }
   }
   // Reverse diffusion first, the paper's choice, where S2 has at least as many vertices as S1. Its
@@ -432,8 +412,9 @@ DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diff
                       "inspect quality(field).folds");
 }
 
-DisplacementField3 directed(MapMethod method, const Work& work, const ShellDiffusionOptions& diffusion) {
-  if (method == MapMethod::automatic) return automatic(work, diffusion);
+DisplacementField3 directed(MapMethod method, const Work& work, const ShellDiffusionOptions& diffusion,
+                            bool coarsen = true) {
+  if (method == MapMethod::automatic) return automatic(work, diffusion, nullptr, coarsen);
   if (method == MapMethod::diffusion) return diffusion_field(work, false, diffusion);
   return basic(method, work.user, *work.user_target, diffusion, work.user_source);
 }
@@ -517,7 +498,7 @@ Work work_pair(const Pair& user, Refined& refined1, Refined& refined2) {
 
 // map_surfaces on two checked surfaces: each converted to CGAL's form and tested for
 // self-intersections once, here, for every algorithm and direction the call runs.
-DisplacementField3 checked(Surface s1, Surface s2, const SurfaceMappingOptions& options) {
+DisplacementField3 checked(Surface s1, Surface s2, const SurfaceMappingOptions& options, bool coarsen) {
   if (!method_row(options.method).surfaces) {
     detail::invalid("method", std::string(map_method_name(options.method)) + " mapping has no 3D form; use " +
                                   quoted_method_names(&MethodRow::surfaces));
@@ -557,7 +538,7 @@ DisplacementField3 checked(Surface s1, Surface s2, const SurfaceMappingOptions& 
     return evened(options.reverse ? automatic(work.swapped(), diffusion, &work) : automatic(work, diffusion), user,
                   diffusion);
   }
-  if (!options.reverse) return directed(options.method, work, diffusion);
+  if (!options.reverse) return directed(options.method, work, diffusion, coarsen);
   if (options.method == MapMethod::automatic) return automatic(work.swapped(), diffusion, &work);
   return carried(directed(options.method, work.swapped(), diffusion), user, *s1.index, *s2.index);
 }
@@ -576,13 +557,13 @@ DisplacementField3 map_surfaces(const Points3Ref& v1, const FacesRef& f1, const 
         volume2 = check_closed_surface(v2, f2, "s2");
         detail::require_outward(volume2, "s2");
       });
-  return checked(Surface{v1, f1, volume1}, Surface{v2, f2, volume2}, options);
+  return checked(Surface{v1, f1, volume1}, Surface{v2, f2, volume2}, options, true);
 }
 
 DisplacementField3 map_surfaces(const PreparedSurface& s1, const PreparedSurface& s2,
                                 const SurfaceMappingOptions& options) {
   return checked(Surface{s1.vertices(), s1.faces(), s1.volume(), &s1.index(), &s1.closed()},
-                 Surface{s2.vertices(), s2.faces(), s2.volume(), &s2.index(), &s2.closed()}, options);
+                 Surface{s2.vertices(), s2.faces(), s2.volume(), &s2.index(), &s2.closed()}, options, true);
 }
 
 }  // namespace morphomap
