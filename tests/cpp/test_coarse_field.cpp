@@ -47,11 +47,11 @@ double radial_error(const DisplacementField3& field) {
 void test_radial_map_carried_onto_the_fine_sphere() {
   // Subdivision keeps the coarse icosphere's vertices, so the coarse copies lie on the fine ones.
   const auto s1 = icosphere(5), s2 = scaled(icosphere(5), kScale, kScale, kScale);
-  const auto c1 = icosphere(2);
+  const auto c1 = icosphere(2), c2 = scaled(icosphere(2), kScale, kScale, kScale);
   const SurfaceIndex index1(s1.vertices, s1.faces), index2(s2.vertices, s2.faces);
   DisplacementField3 coarse = coarse_radial(c1);
-  const DisplacementField3 field = morphomap::detail::carried_from_coarse(coarse, s1.vertices, s1.faces, index1,
-                                                                          s2.vertices, s2.faces, index2);
+  const DisplacementField3 field = morphomap::detail::carried_from_coarse(
+      coarse, c2.vertices, c2.faces, s1.vertices, s1.faces, index1, s2.vertices, s2.faces, index2);
   CHECK(field.size() == s1.vertices.rows());
   CHECK(field.faces == s1.faces);
   for (Index i = 0; i < field.size(); ++i) CHECK(field.valid(i) && field.methods[i] == Method::diffusion);
@@ -64,8 +64,8 @@ void test_radial_map_carried_onto_the_fine_sphere() {
                                s2.faces, index2) == 0);
   // A coarse vertex without an end: the fine vertices around it take their neighbours' ends.
   coarse.ends.row(0).setConstant(std::numeric_limits<double>::quiet_NaN());
-  const DisplacementField3 holed = morphomap::detail::carried_from_coarse(coarse, s1.vertices, s1.faces, index1,
-                                                                          s2.vertices, s2.faces, index2);
+  const DisplacementField3 holed = morphomap::detail::carried_from_coarse(
+      coarse, c2.vertices, c2.faces, s1.vertices, s1.faces, index1, s2.vertices, s2.faces, index2);
   for (Index i = 0; i < holed.size(); ++i) CHECK(holed.valid(i));
   // Within a tenth of the hole's radius (a coarse edge, 0.45 on S2) of the radial map.
   CHECK(radial_error(holed) < 0.045);

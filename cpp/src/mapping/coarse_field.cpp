@@ -5,6 +5,8 @@
 #include "quality/folds.hpp"
 #include "surfaces/surface_util.hpp"
 
+#include <Eigen/Geometry>
+
 #include <cmath>
 #include <vector>
 
@@ -16,9 +18,24 @@ double coarse_edge(const Points3Ref& v1, const FacesRef& f1) {
   return std::sqrt(2.0 * surface_area(v1, f1) / (std::sqrt(3.0) * static_cast<double>(kCoarseVertices)));
 }
 
-DisplacementField3 carried_from_coarse(const DisplacementField3& coarse, const Points3Ref& v1, const FacesRef& f1,
-                                       const SurfaceIndex& index1, const Points3Ref& v2, const FacesRef& f2,
-                                       const SurfaceIndex& index2) {
+namespace {
+
+// The barycentric coordinates of `x` (on or near triangle `face` of (v, f)).
+Eigen::Vector3d barycentric(const Points3Ref& v, const FacesRef& f, Index face, const Eigen::Vector3d& x) {
+  const Eigen::Vector3d a = v.row(f(face, 0)).transpose(), e1 = v.row(f(face, 1)).transpose() - a,
+                        e2 = v.row(f(face, 2)).transpose() - a, d = x - a;
+  const double g11 = e1.dot(e1), g12 = e1.dot(e2), g22 = e2.dot(e2), r1 = d.dot(e1), r2 = d.dot(e2);
+  const double det = g11 * g22 - g12 * g12;
+  if (!(det > 0.0)) return Eigen::Vector3d(1.0, 0.0, 0.0);
+  const double l1 = (g22 * r1 - g12 * r2) / det, l2 = (g11 * r2 - g12 * r1) / det;
+  return Eigen::Vector3d(1.0 - l1 - l2, l1, l2);
+}
+
+}  // namespace
+
+DisplacementField3 carried_from_coarse(const DisplacementField3& coarse, const Points3Ref& c2, const FacesRef& g2,
+                                       const Points3Ref& v1, const FacesRef& f1, const SurfaceIndex& index1,
+                                       const Points3Ref& v2, const FacesRef& f2, const SurfaceIndex& index2) {
   // The coarse field read as a piecewise-linear map on c1's triangles, which lie on S1: the same
   // location and interpolation as a reversed field carried onto S1's vertices.
   DisplacementField3 field = carried_onto_source(coarse, v1, f1);
@@ -26,8 +43,25 @@ DisplacementField3 carried_from_coarse(const DisplacementField3& coarse, const P
   for (Index i = 0; i < field.size(); ++i) {
     if (field.ends.row(i).allFinite()) placed.push_back(i);
   }
-  const SurfaceHits on_target = index2.closest_points(field.ends(placed, Eigen::all));
-  for (std::size_t k = 0; k < placed.size(); ++k) field.ends.row(placed[k]) = on_target.points.row(static_cast<Index>(k));
+  const Points3 near = field.ends(placed, Eigen::all);
+  // c2's normal at each point, interpolated from its vertex normals.
+  const SurfaceHits on_coarse = SurfaceIndex(c2, g2).closest_points(near);
+  const Points3 normals = vertex_normals(c2, g2);
+  Points3 directions(near.rows(), 3);
+  for (Index k = 0; k < near.rows(); ++k) {
+    const Index face = on_coarse.faces[k];
+    const Eigen::Vector3d b = barycentric(c2, g2, face, on_coarse.points.row(k).transpose());
+    directions.row(k) =
+        b[0] * normals.row(g2(face, 0)) + b[1] * normals.row(g2(face, 1)) + b[2] * normals.row(g2(face, 2));
+  }
+  const SurfaceHits closest = index2.closest_points(near);
+  const SurfaceHits along = index2.line_intersections(near, directions);
+  for (std::size_t k = 0; k < placed.size(); ++k) {
+    const Index row = static_cast<Index>(k);
+    const bool hit =
+        std::isfinite(along.distances[row]) && std::abs(along.distances[row]) <= kRayReach * closest.distances[row];
+    field.ends.row(placed[k]) = hit ? along.points.row(row) : closest.points.row(row);
+  }
   fill_lost_ends(field, index2);
   unfold(field.starts, field.ends, field.faces, v1, f1, index1, v2, f2, index2);
   return field;

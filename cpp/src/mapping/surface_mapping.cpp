@@ -290,8 +290,8 @@ DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diff
   const auto last_resort = [&]() -> std::optional<DisplacementField3> {
     if (!least || least_tried) return std::nullopt;
     if (diffusion.on_stage) diffusion.on_stage("untangle");
-    if (std::optional<DisplacementField3> field = detail::untangled(*least, test, s1.vertices, s1.faces, *call.user_source,
-                                                                    s2.vertices, s2.faces, *call.user_target))
+    if (std::optional<DisplacementField3> field = detail::untangled(
+            *least, test, s1.vertices, s1.faces, *call.user_source, s2.vertices, s2.faces, *call.user_target))
       return field;
     least_tried = true;
     tried.emplace_back("the least folded of these, its ends moved along s2: folds remain", Defects{-1, -1});
@@ -337,12 +337,16 @@ DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diff
           checked(Surface{c1.vertices, c1.faces, check_closed_surface(c1.vertices, c1.faces, "coarse copy of s1")},
                   Surface{c2.vertices, c2.faces, check_closed_surface(c2.vertices, c2.faces, "coarse copy of s2")},
                   options, false);
-      DisplacementField3 field = detail::carried_from_coarse(coarse, s1.vertices, s1.faces, *call.user_source,
-                                                             s2.vertices, s2.faces, *call.user_target);
+      DisplacementField3 field =
+          detail::carried_from_coarse(coarse, c2.vertices, c2.faces, s1.vertices, s1.faces, *call.user_source,
+                                      s2.vertices, s2.faces, *call.user_target);
       const Defects found = defects(field, test);
       if (found.none()) return field;
       tried.emplace_back(name + ", carried", found);
       keep(field, found);
+      // Its few folds (slivers crowded where S2 creases) turned back at once, before the
+      // whole-resolution diffusions: the unblurred voxel limb 290 -> 270 h maps so in 7.4 s, not 43.
+      if (std::optional<DisplacementField3> repaired = last_resort()) return *repaired;
     } catch (const GeometryError&) {  // its own message lists the coarse copies' candidates
       tried.emplace_back(name + ": no complete, fold-free field there either", Defects{-1, -1});
     } catch (const InvalidInput& error) {  // a copy remeshed into a surface that is not closed and outward

@@ -59,5 +59,4 @@ std::optional<DisplacementField3> untangled(DisplacementField3 field, const Fold
   return field;
 }
 
-
 }  // namespace morphomap::detail
