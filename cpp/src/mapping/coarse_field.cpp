@@ -5,8 +5,6 @@
 #include "quality/folds.hpp"
 #include "surfaces/surface_util.hpp"
 
-#include <Eigen/Geometry>
-
 #include <cmath>
 #include <vector>
 
@@ -17,21 +15,6 @@ bool worth_coarsening(const Points3Ref& v1) { return v1.rows() > 2 * kCoarseVert
 double coarse_edge(const Points3Ref& v1, const FacesRef& f1) {
   return std::sqrt(2.0 * surface_area(v1, f1) / (std::sqrt(3.0) * static_cast<double>(kCoarseVertices)));
 }
-
-namespace {
-
-// The barycentric coordinates of `x` (on or near triangle `face` of (v, f)).
-Eigen::Vector3d barycentric(const Points3Ref& v, const FacesRef& f, Index face, const Eigen::Vector3d& x) {
-  const Eigen::Vector3d a = v.row(f(face, 0)).transpose(), e1 = v.row(f(face, 1)).transpose() - a,
-                        e2 = v.row(f(face, 2)).transpose() - a, d = x - a;
-  const double g11 = e1.dot(e1), g12 = e1.dot(e2), g22 = e2.dot(e2), r1 = d.dot(e1), r2 = d.dot(e2);
-  const double det = g11 * g22 - g12 * g12;
-  if (!(det > 0.0)) return Eigen::Vector3d(1.0, 0.0, 0.0);
-  const double l1 = (g22 * r1 - g12 * r2) / det, l2 = (g11 * r2 - g12 * r1) / det;
-  return Eigen::Vector3d(1.0 - l1 - l2, l1, l2);
-}
-
-}  // namespace
 
 DisplacementField3 carried_from_coarse(const DisplacementField3& coarse, const Points3Ref& c2, const FacesRef& g2,
                                        const Points3Ref& v1, const FacesRef& f1, const SurfaceIndex& index1,
@@ -50,7 +33,8 @@ DisplacementField3 carried_from_coarse(const DisplacementField3& coarse, const P
   Points3 directions(near.rows(), 3);
   for (Index k = 0; k < near.rows(); ++k) {
     const Index face = on_coarse.faces[k];
-    const Eigen::Vector3d b = barycentric(c2, g2, face, on_coarse.points.row(k).transpose());
+    const V3 b = barycentric(corner(c2, g2, face, 0), corner(c2, g2, face, 1), corner(c2, g2, face, 2),
+                             on_coarse.points.row(k).transpose());
     directions.row(k) =
         b[0] * normals.row(g2(face, 0)) + b[1] * normals.row(g2(face, 1)) + b[2] * normals.row(g2(face, 2));
   }

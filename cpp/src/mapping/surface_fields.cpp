@@ -3,6 +3,7 @@
 #include "mapping/surface_fields.hpp"
 
 #include "common/mesh_adjacency.hpp"
+#include "surfaces/surface_util.hpp"
 
 #include <tbb/parallel_for.h>
 #include <Eigen/Geometry>
@@ -13,22 +14,6 @@
 #include <vector>
 
 namespace morphomap::detail {
-
-namespace {
-
-using Vec3 = Eigen::Vector3d;
-
-// Barycentric coordinates of x (on or near the plane of a, b, c) in that triangle.
-Vec3 barycentric(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& x) {
-  const Vec3 e1 = b - a, e2 = c - a, d = x - a;
-  const double g11 = e1.dot(e1), g12 = e1.dot(e2), g22 = e2.dot(e2), r1 = d.dot(e1), r2 = d.dot(e2);
-  const double det = g11 * g22 - g12 * g12;
-  if (!(det > 0.0)) return Vec3(1.0, 0.0, 0.0);
-  const double l1 = (g22 * r1 - g12 * r2) / det, l2 = (g11 * r2 - g12 * r1) / det;
-  return Vec3(1.0 - l1 - l2, l1, l2);
-}
-
-}  // namespace
 
 DisplacementField3 carried_onto_source(const DisplacementField3& reverse, const Points3Ref& v1, const FacesRef& f1) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -44,9 +29,9 @@ DisplacementField3 carried_onto_source(const DisplacementField3& reverse, const 
     bool mapped = true;
     for (int j = 0; j < 3; ++j) mapped = mapped && reverse.starts.row(reverse.faces(k, j)).allFinite();
     if (!mapped) continue;
-    const Vec3 a = reverse.starts.row(reverse.faces(k, 0)).transpose();
-    const Vec3 b = reverse.starts.row(reverse.faces(k, 1)).transpose();
-    const Vec3 c = reverse.starts.row(reverse.faces(k, 2)).transpose();
+    const V3 a = reverse.starts.row(reverse.faces(k, 0)).transpose();
+    const V3 b = reverse.starts.row(reverse.faces(k, 1)).transpose();
+    const V3 c = reverse.starts.row(reverse.faces(k, 2)).transpose();
     if ((b - a).cross(c - a).squaredNorm() > 0.0) kept.push_back(k);
   }
   if (kept.empty()) return field;
@@ -62,10 +47,10 @@ DisplacementField3 carried_onto_source(const DisplacementField3& reverse, const 
     const Index k = hits.faces[i];
     if (k < 0) return;
     const Index a = image_faces(k, 0), b = image_faces(k, 1), c = image_faces(k, 2);
-    const Vec3 pa = image.row(a).transpose(), pb = image.row(b).transpose(), pc = image.row(c).transpose();
+    const V3 pa = image.row(a).transpose(), pb = image.row(b).transpose(), pc = image.row(c).transpose();
     const double reach = std::max({(pb - pa).norm(), (pc - pb).norm(), (pa - pc).norm()});
     if (!(hits.distances[i] <= reach)) return;
-    Vec3 w = barycentric(pa, pb, pc, hits.points.row(i).transpose());
+    V3 w = barycentric(pa, pb, pc, hits.points.row(i).transpose());
     w = w.cwiseMax(0.0);
     w /= w.sum();
     field.ends.row(i) = w[0] * reverse.ends.row(a) + w[1] * reverse.ends.row(b) + w[2] * reverse.ends.row(c);

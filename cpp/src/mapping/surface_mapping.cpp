@@ -245,11 +245,13 @@ double area_ratio(const Pair& pair) {
 // "auto": one vector per vertex of S1, every one mapped and no triangle folded, or GeometryError.
 // Tried in turn, the first such field returned: normal mapping; between nested surfaces, the
 // normal field with diffusion near where it failed (local_diffusion.hpp); where S1 is large and
-// `coarsen`, auto on coarse copies of the pair carried back (coarse_field.hpp); reverse diffusion
-// carried onto S1's vertices (the paper's choice where normal mapping fails) and diffusion, in
-// that order unless S2 has fewer vertices than S1; the complete one with the fewest folds so far,
-// untangled; minimal distance; reverse normal mapping and reverse minimal distance, carried; then
-// the complete one with the fewest folds, untangled, where it is another.
+// `coarsen`, auto on coarse copies of the pair carried back (coarse_field.hpp), then the complete
+// one with the fewest folds so far untangled (untangled_field.hpp); reverse diffusion carried onto
+// S1's vertices (the paper's choice where normal mapping fails) and diffusion, in that order
+// unless S2 has fewer vertices than S1; the complete one with the fewest folds so far, untangled,
+// where it is another; minimal distance; reverse normal mapping and reverse minimal distance,
+// carried, unless the coarse copies were mapped; then the complete one with the fewest folds,
+// untangled, where it is another.
 // Diffusion's lost streamlines are filled and its turned slivers repaired within each. `outer`:
 // where this runs the other way round (reverse), the call's own work pair: each candidate is
 // carried onto its S1 and judged there.
@@ -321,36 +323,43 @@ DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diff
   }
   // A large S1 (thousands of small triangles, contoured from voxels) through coarse copies of the
   // pair: auto on copies remeshed at about kCoarseVertices vertices of S1, carried back. The
-  // blurred voxel limb 270 -> 290 h maps so in 8 s, where every whole-resolution candidate folded
-  // (bench/README.md "Real 3D stages"). Not reversed: that call's S1 is the other surface.
-  if (coarsen && outer == nullptr && diffusable && detail::worth_coarsening(s1.vertices)) {
+  // voxelised limb stages 270 <-> 290 h map so in 5-7 s, where every whole-resolution candidate
+  // folded (bench/README.md "Real 3D stages"). Not reversed: that call's S1 is the other surface.
+  const bool coarse_tried = coarsen && outer == nullptr && diffusable && detail::worth_coarsening(s1.vertices);
+  if (coarse_tried) {
     const double edge = detail::coarse_edge(s1.vertices, s1.faces);
     const std::string name = "auto on copies remeshed at edge length " + std::to_string(edge);
+    std::optional<DisplacementField3> coarse;
+    TriangleSurface c1, c2;
     try {
-      TriangleSurface c1, c2;
       detail::run_both([&] { c1 = remesh_surface(s1.vertices, s1.faces, edge, detail::kCoarseRemeshing); },
                        [&] { c2 = remesh_surface(s2.vertices, s2.faces, edge, detail::kCoarseRemeshing); });
       SurfaceMappingOptions options;
       options.diffusion_repeatable = diffusion.repeatable;
       options.on_stage = diffusion.on_stage;
-      const DisplacementField3 coarse =
-          checked(Surface{c1.vertices, c1.faces, check_closed_surface(c1.vertices, c1.faces, "coarse copy of s1")},
-                  Surface{c2.vertices, c2.faces, check_closed_surface(c2.vertices, c2.faces, "coarse copy of s2")},
-                  options, false);
+      const Surface copy1{c1.vertices, c1.faces, check_closed_surface(c1.vertices, c1.faces, "coarse copy of s1")};
+      const Surface copy2{c2.vertices, c2.faces, check_closed_surface(c2.vertices, c2.faces, "coarse copy of s2")};
+      try {
+        coarse = checked(copy1, copy2, options, false);
+      } catch (const GeometryError&) {  // its own message lists the copies' candidates
+        tried.emplace_back(name + ": no complete, fold-free field there either", Defects{-1, -1});
+      }
+    } catch (const GeometryError& error) {  // remeshing that could not repair a self-intersection
+      tried.emplace_back(name + " (" + error.what() + ")", Defects{-1, -1});
+    } catch (const InvalidInput& error) {  // copies that are not closed, outward and overlapping
+      tried.emplace_back(name + " (" + error.what() + ")", Defects{-1, -1});
+    }
+    if (coarse) {
       DisplacementField3 field =
-          detail::carried_from_coarse(coarse, c2.vertices, c2.faces, s1.vertices, s1.faces, *call.user_source,
+          detail::carried_from_coarse(*coarse, c2.vertices, c2.faces, s1.vertices, s1.faces, *call.user_source,
                                       s2.vertices, s2.faces, *call.user_target);
       const Defects found = defects(field, test);
       if (found.none()) return field;
       tried.emplace_back(name + ", carried", found);
       keep(field, found);
       // Its few folds (slivers crowded where S2 creases) turned back at once, before the
-      // whole-resolution diffusions: the unblurred voxel limb 290 -> 270 h maps so in 7.4 s, not 43.
+      // whole-resolution diffusions: the unblurred voxel limb 290 -> 270 h maps so in 6.2 s, not 43.
       if (std::optional<DisplacementField3> repaired = last_resort()) return *repaired;
-    } catch (const GeometryError&) {  // its own message lists the coarse copies' candidates
-      tried.emplace_back(name + ": no complete, fold-free field there either", Defects{-1, -1});
-    } catch (const InvalidInput& error) {  // a copy remeshed into a surface that is not closed and outward
-      tried.emplace_back(name + " (" + error.what() + ")", Defects{-1, -1});
     }
   }
   // Reverse diffusion first, the paper's choice, where S2 has at least as many vertices as S1. Its
@@ -391,7 +400,11 @@ DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diff
   if (nearest_defects.none()) return nearest;
   tried.emplace_back("minimal distance", nearest_defects);
   keep(nearest, nearest_defects);
+  // Not where coarse copies were mapped, whose candidates include these: carried from a large S2
+  // they cost the voxelised limb 270 -> 250 h 10-16 s and folded 694-2,475 triangles
+  // (bench/README.md "Real 3D stages").
   for (const MapMethod method : {MapMethod::normal, MapMethod::minimal_distance}) {
+    if (coarse_tried) break;
     DisplacementField3 back = outer != nullptr ? basic(method, outer->user, *outer->user_target, diffusion)
                                                : carried(basic(method, pair.swapped(), source_index, diffusion), pair,
                                                          source_index, target_index);

@@ -32,6 +32,17 @@ inline double surface_area(const Points3Ref& v, const FacesRef& f) {
   return area;
 }
 
+// Barycentric coordinates of x (on or near the plane of triangle abc) in it; (1, 0, 0) where the
+// triangle has no area.
+inline V3 barycentric(const V3& a, const V3& b, const V3& c, const V3& x) {
+  const V3 e1 = b - a, e2 = c - a, d = x - a;
+  const double g11 = e1.dot(e1), g12 = e1.dot(e2), g22 = e2.dot(e2), r1 = d.dot(e1), r2 = d.dot(e2);
+  const double det = g11 * g22 - g12 * g12;
+  if (!(det > 0.0)) return V3(1.0, 0.0, 0.0);
+  const double l1 = (g22 * r1 - g12 * r2) / det, l2 = (g11 * r2 - g12 * r1) / det;
+  return V3(1.0 - l1 - l2, l1, l2);
+}
+
 // Closest point to p on triangle abc (Ericson, "Real-Time Collision Detection" 5.1.5: walk the
 // Voronoi regions of the vertices, edges and face); exact for degenerate triangles too.
 inline V3 closest_on_triangle(const V3& p, const V3& a, const V3& b, const V3& c) {
