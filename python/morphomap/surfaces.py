@@ -117,14 +117,15 @@ def map_surfaces(s1, s2, method="auto", *, reverse=False, mesh_size=None, repeat
         put on ``s2`` along the copy of ``s2``'s normal (or at its closest point where that meets
         ``s2`` far off), and, where a few triangles fold, the last resort on it at once; reverse
         diffusion carried onto ``s1``'s vertices (the paper's choice; diffusion first where
-        ``s2`` has fewer vertices); diffusion; the last
-        resort on the complete field with the fewest folded triangles so far; minimal distance;
-        normal mapping and minimal distance from ``s2``'s vertices, carried onto ``s1``'s; the
-        last resort on the least folded of all, where that is another. With ``reverse=True`` the
-        same ways run from ``s2``, each carried onto ``s1`` and judged there, without the coarse
-        copies. A diffusion field with a few folded triangles left has the ends around them (up
-        to 4 edges away) re-placed by the harmonic interpolation of the ends around, put on ``s2``, if that leaves
-        no fold. The last resort moves the ends within 10 edges of the folded triangles along
+        ``s2`` has fewer vertices); diffusion; the last resort on the complete field with the
+        fewest folded triangles so far; minimal distance; normal mapping and minimal distance
+        from ``s2``'s vertices, carried onto ``s1``'s (not after the coarse copies, whose
+        candidates include them); the last resort on the least folded of all, where that is
+        another. With ``reverse=True`` the same ways run from ``s2``, each carried onto ``s1``
+        and judged there, without the coarse copies. A diffusion field with a few folded
+        triangles left has the ends around them (up to 4 edges away) re-placed by the harmonic
+        interpolation of the ends around, put on ``s2``, if that leaves no fold. The last resort
+        moves the ends within 10 edges of the folded triangles along
         ``s2`` by the descent of ``"optimal"``, a folded triangle's area ratio counting negative,
         until none is folded (at most 5,000 ends and 40 steps; those vectors are labelled
         ``"optimal"``), else gives up.

@@ -28,10 +28,11 @@ struct SurfaceMappingOptions {
   //   field carried back onto S1's vertices; reverse diffusion carried onto S1's vertices and
   //   diffusion (forward first where S2 has fewer vertices; each with the ends around its last
   //   folds re-placed by harmonic interpolation where that removes them); minimal distance;
-  //   reverse normal mapping and reverse minimal distance, carried. The complete field with the
-  //   fewest folds so far has the ends around its folds moved along S2 until they unfold (after
-  //   the coarse copies, after the diffusions, and at the end), where that succeeds. Reversed,
-  //   the same ways from S2 without the coarse copies, each carried onto S1 and judged there.
+  //   reverse normal mapping and reverse minimal distance, carried (not after the coarse
+  //   copies, whose candidates include them). The complete field with the fewest folds so far
+  //   has the ends around its folds moved along S2 until they unfold (after the coarse copies,
+  //   after the diffusions, and at the end), where that succeeds. Reversed, the same ways from
+  //   S2 without the coarse copies, each carried onto S1 and judged there.
   // optimal: auto's field, then its ends moved along S2 so that every triangle's image keeps its
   //   share of S2's area (the sum of (A'/(alpha A) - 1)^2 over the triangles, QM1 of the 3D quality
   //   measure, lowered in steps that fold no triangle and keep every end on S2); every vector
