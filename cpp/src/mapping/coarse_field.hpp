@@ -5,7 +5,6 @@
 // surfaces cross (its streamlines part over a few of the many small triangles) while the coarse
 // copies map fold-free (bench/README.md "Real 3D stages").
 #include <morphomap/field.hpp>
-#include <morphomap/remesh.hpp>
 #include <morphomap/surface_queries.hpp>
 #include <morphomap/types.hpp>
 
