@@ -327,6 +327,7 @@ DisplacementField3 automatic(const Work& work, const ShellDiffusionOptions& diff
   // folded (bench/README.md "Real 3D stages"). Not reversed: that call's S1 is the other surface.
   const bool coarse_tried = coarsen && outer == nullptr && diffusable && detail::worth_coarsening(s1.vertices);
   if (coarse_tried) {
+    if (diffusion.on_stage) diffusion.on_stage("coarse copies");
     const double edge = detail::coarse_edge(s1.vertices, s1.faces);
     const std::string name = "auto on copies remeshed at edge length " + std::to_string(edge);
     std::optional<DisplacementField3> coarse;
