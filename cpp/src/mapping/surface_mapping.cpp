@@ -236,12 +236,6 @@ std::optional<DisplacementField3> smoothed_over_folds(const DisplacementField3& 
   return std::nullopt;
 }
 
-// area(S2) / area(S1): the factor even_ends holds every triangle's area to.
-double area_ratio(const Pair& pair) {
-  return detail::surface_area(pair.target.vertices, pair.target.faces) /
-         detail::surface_area(pair.source.vertices, pair.source.faces);
-}
-
 // "auto": one vector per vertex of S1, every one mapped and no triangle folded, or GeometryError.
 // Tried in turn, the first such field returned: normal mapping; between nested surfaces, the
 // normal field with diffusion near where it failed (local_diffusion.hpp); where S1 is large and
@@ -447,7 +441,7 @@ DisplacementField3 evened(DisplacementField3 field, const Pair& user, const Shel
   const detail::FoldTest test(s1.vertices, s1.faces, s1.vertices, s1.faces, *s1.index, s2.vertices, s2.faces,
                               *s2.index);
   field.ends = detail::even_ends(field.starts, field.ends, field.faces, test, s2.vertices, s2.faces, *s2.index,
-                                 area_ratio(user));
+                                 detail::area_factor(s1.vertices, s1.faces, s2.vertices, s2.faces));
   std::fill(field.methods.begin(), field.methods.end(), Method::optimal);
   return field;
 }

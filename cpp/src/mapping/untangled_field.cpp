@@ -50,7 +50,7 @@ std::optional<DisplacementField3> untangled(DisplacementField3 field, const Fold
     for (int i = 0; i < 3; ++i) part(static_cast<Index>(k), i) = local[static_cast<std::size_t>(faces(kept[k], i))];
   }
   const FoldTest part_test(starts, part, v1, f1, index1, v2, f2, index2);
-  const double alpha = surface_area(v2, f2) / surface_area(v1, f1);
+  const double alpha = area_factor(v1, f1, v2, f2);
   const Points3 moved = even_ends(starts, ends, part, part_test, v2, f2, index2, alpha, options);
   for (Index k = 0; k < count; ++k) field.ends.row(rows[static_cast<std::size_t>(k)]) = moved.row(k);
   const std::vector<char> folded = test.folded(field.ends);

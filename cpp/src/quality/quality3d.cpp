@@ -211,7 +211,7 @@ SurfaceQuality checked_quality(const DisplacementField3& field, const Points3Ref
   require_on(field.starts, v1, index1, "start point");
   require_on(field.ends, v2, index2, "end point");
 
-  const double alpha = detail::surface_area(v2, f2) / detail::surface_area(v1, f1);
+  const double alpha = detail::area_factor(v1, f1, v2, f2);
   const Index count = field.faces.rows();
   std::vector<double> ratio(count, kNaN), volume(count, kNaN);
   for (Index j = 0; j < count; ++j) {

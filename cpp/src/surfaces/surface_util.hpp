@@ -32,6 +32,12 @@ inline double surface_area(const Points3Ref& v, const FacesRef& f) {
   return area;
 }
 
+// area(S2) / area(S1): the factor alpha of the 3D quality measure's QM1, against which each
+// triangle's change of area is measured (quality3d.cpp) and to which even_ends holds it.
+inline double area_factor(const Points3Ref& v1, const FacesRef& f1, const Points3Ref& v2, const FacesRef& f2) {
+  return surface_area(v2, f2) / surface_area(v1, f1);
+}
+
 // Barycentric coordinates of x (on or near the plane of triangle abc) in it; (1, 0, 0) where the
 // triangle has no area.
 inline V3 barycentric(const V3& a, const V3& b, const V3& c, const V3& x) {
