@@ -181,17 +181,21 @@ def _surface(volume, spacing, style_kind):
     return mesh, components
 
 
-def surface_pair(seed: int, style: str | None = None) -> SurfacePair:
-    """The 3D pair of frames of ``seed`` (style: ``style_of(seed)`` unless given)."""
+def surface_pair(seed: int, style: str | None = None, fine: int = 1) -> SurfacePair:
+    """The 3D pair of frames of ``seed`` (style: ``style_of(seed)`` unless given). ``fine``: voxels
+    that many times smaller along each axis, the same shapes (``fine=4``: some 10,000-25,000
+    vertices, the large surfaces the default maps through coarse copies)."""
     style = style_of(seed) if style is None else style
     if style not in STYLES:
         raise ValueError(f"style: expected one of {STYLES}, got {style!r}")
     rng = rng_of(seed, 3)
-    spacing = SPACINGS_3D[int(rng.integers(len(SPACINGS_3D)))]
-    # The finest axis has 24-34 voxels and the physical extents are about equal, as in a stack
-    # with few, thick z slices.
-    length = rng.uniform(24, 34) * min(spacing)
-    shape = tuple(int(np.clip(round(length * rng.uniform(0.9, 1.15) / s), 12, 38)) for s in spacing)  # (nz, ny, nx)
+    coarsest = SPACINGS_3D[int(rng.integers(len(SPACINGS_3D)))]
+    # The finest axis has 24-34 voxels (times `fine`) and the physical extents are about equal, as
+    # in a stack with few, thick z slices.
+    length = rng.uniform(24, 34) * min(coarsest)
+    spacing = tuple(s / fine for s in coarsest)
+    shape = tuple(int(np.clip(round(length * rng.uniform(0.9, 1.15) / s), 12 * fine, 38 * fine))
+                  for s in spacing)  # (nz, ny, nx)
     extent = np.array([shape[2] * spacing[2], shape[1] * spacing[1], shape[0] * spacing[0]])  # x, y, z
     centre = extent * rng.uniform(0.46, 0.54, 3)
     room = np.minimum(centre, extent - centre) - 1.5 * np.array(spacing[::-1])
@@ -217,7 +221,7 @@ def surface_pair(seed: int, style: str | None = None) -> SurfacePair:
         kind = "swell"
         reach = swell.uniform(1.0, 1.8) * max(spacing)
         m2 = ndimage.distance_transform_edt(~m1, sampling=spacing) <= reach
-    info = dict(dim=3, seed=int(seed), style=style, kind=kind, spacing=spacing, shape=shape,
+    info = dict(dim=3, seed=int(seed), style=style, kind=kind, spacing=spacing, shape=shape, fine=fine,
                 buds=sum(h > 0 for _, h, _ in blob.bumps), necks=sum(h < 0 for _, h, _ in blob.bumps),
                 knobs=len(blob.knobs), attempts=attempt + 1)
 

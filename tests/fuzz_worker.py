@@ -1,7 +1,7 @@
 """The child process of tests/test_fuzz_frames.py: maps the pairs of tests/frames.py, checks the result.
 
 Serve mode (what the test uses): ``python fuzz_worker.py --serve`` reads one case per line on
-stdin, as JSON ``{"id", "dim", "seed", "style", "method", "reverse", "transform", "split"}``, and
+stdin, as JSON ``{"id", "dim", "seed", "style", "method", "reverse", "transform", "split", "fine"}``, and
 answers on stdout with JSON lines: ``{"ready": true}`` once imported, ``{"id", "phase"}`` before
 each step (so that the parent knows where a crash happened) and ``{"id", "result": {...}}`` at the
 end. The parent restarts it after a crash or a time-out. Anything the library prints goes to
@@ -96,10 +96,10 @@ class Worker:
         self.allowed = (ValueError, TypeError) + ((geometry,) if geometry is not None else ())
         self.geometry = geometry
 
-    def pair(self, dim, seed, style):
-        key = (dim, seed, style)
+    def pair(self, dim, seed, style, fine):
+        key = (dim, seed, style, fine)
         if self._cached is None or self._cached[0] != key:
-            self._cached = (key, self.frames.pair(dim, seed, style))
+            self._cached = (key, self.frames.pair(dim, seed, style, fine))
         return self._cached[1]
 
     def run(self, case):
@@ -110,7 +110,7 @@ class Worker:
         dim, seed, style = int(case["dim"]), int(case["seed"]), case.get("style")
         result = {"phase": "frames"}
         self.say({"id": ident, "phase": "frames"})
-        made = self.pair(dim, seed, style)
+        made = self.pair(dim, seed, style, int(case.get("fine", 1)))
         result["info"] = made.info
         result["identical"] = bool(made.identical)
         method, reverse = case["method"], bool(case.get("reverse", False))
@@ -263,6 +263,7 @@ def main(argv=None):
     parser.add_argument("--reverse", action="store_true")
     parser.add_argument("--transform", action="store_true")
     parser.add_argument("--no-split", action="store_true")
+    parser.add_argument("--fine", type=int, default=1, help="3D: voxels this many times finer")
     args = parser.parse_args(argv)
     if args.serve:
         serve()
@@ -271,7 +272,7 @@ def main(argv=None):
         parser.error("give dim and seed (or --serve)")
     faulthandler.enable(all_threads=True)
     case = {"id": 0, "dim": args.dim, "seed": args.seed, "style": args.style, "method": args.method,
-            "reverse": args.reverse, "transform": args.transform, "split": not args.no_split}
+            "reverse": args.reverse, "transform": args.transform, "split": not args.no_split, "fine": args.fine}
     print(json.dumps(case), flush=True)
     result = Worker(lambda message: print(json.dumps(_jsonable(message)), flush=True)).run(case)
     print(json.dumps(_jsonable(result), indent=1))
