@@ -166,9 +166,10 @@ def map_surfaces(s1, s2, method="auto", *, reverse=False, mesh_size=None, repeat
         ``normal``, then diffusion's ``mesh``, ``solve``, ``trace``; where ``"auto"`` falls back
         to whole-surface diffusion after the local one, or to forward after reverse, the bar goes
         back to ``mesh``; it says ``coarse copies`` while a large ``s1`` is mapped through them,
-        whose own stages follow, and ``untangle`` during the last resort). By default shown when stderr is a terminal and the call runs longer
-        than 3 seconds; ``True``: at once; ``False``: never. The other methods are quick and show none; ``"best"`` takes
-        only ``False`` or ``None`` (its candidates run side by side).
+        whose own stages follow, and ``untangle`` during the last resort). By default shown when
+        stderr is a terminal and the call runs longer than 3 seconds; ``True``: at once;
+        ``False``: never. The other methods are quick and show none; ``"best"`` takes only
+        ``False`` or ``None`` (its candidates run side by side).
 
     Returns
     -------
