@@ -183,7 +183,7 @@ def _surface(volume, spacing, style_kind):
 
 def surface_pair(seed: int, style: str | None = None, fine: int = 1) -> SurfacePair:
     """The 3D pair of frames of ``seed`` (style: ``style_of(seed)`` unless given). ``fine``: voxels
-    that many times smaller along each axis, the same shapes (``fine=4``: some 10,000-25,000
+    that many times smaller along each axis, the same shapes (``fine=5``: some 10,000-55,000
     vertices, the large surfaces the default maps through coarse copies)."""
     style = style_of(seed) if style is None else style
     if style not in STYLES:

@@ -37,7 +37,7 @@ Invariants, one test per category and dimension (``test_fuzz_2d[crash]``, ...):
 Variants: 2D, the 5 methods x {plain, reverse}, and on every ``MORPHOMAP_FUZZ_EXTRA_EVERY``-th
 seed auto with ``transform=True`` and auto with ``split=False``; 3D, the 5 methods x {plain,
 reverse}, and on every ``MORPHOMAP_FUZZ_FINE_EVERY``-th seed auto on the same frames contoured
-from voxels 5 times finer (``fine``: 13,000-50,000 vertices, the surfaces the default maps through
+from voxels 5 times finer (``fine``: 10,000-55,000 vertices, the surfaces the default maps through
 coarse copies).
 
 Environment (all optional):
