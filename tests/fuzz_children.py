@@ -32,6 +32,15 @@ def env_float(name, default):
 
 
 TIMEOUT = {2: env_float("MORPHOMAP_FUZZ_TIMEOUT_2D", 60.0), 3: env_float("MORPHOMAP_FUZZ_TIMEOUT_3D", 120.0)}
+# Frames from finer voxels (the "fine" variant) have up to 25 times the vertices: where auto
+# refuses one, it has run whole-resolution diffusion twice (two Mesh_3 runs of about a minute each
+# on 28k vertices; 130 s in all beside another job), which is slow, not hung.
+FINE_TIMEOUT_FACTOR = 3.0
+
+
+def timeout_of(case):
+    """Seconds a case may take before it counts as hung."""
+    return TIMEOUT[case["dim"]] * (FINE_TIMEOUT_FACTOR if int(case.get("fine", 1)) > 1 else 1.0)
 
 
 def _usable_cores():
@@ -240,7 +249,7 @@ def run_cases(cases):
                         return
                     continue
             try:
-                child.send(case, TIMEOUT[case["dim"]])
+                child.send(case, timeout_of(case))
             except OSError:  # the child died between two cases: start a new one for this case
                 child.kill()
                 queue.appendleft(index)
@@ -280,7 +289,7 @@ def run_cases(cases):
                     phase = child.phase
                     child.kill()
                     finish(child, outcome="timeout", phase=phase,
-                           message=f"no answer within {TIMEOUT[child.case['dim']]:g} s (phase {phase})")
+                           message=f"no answer within {timeout_of(child.case):g} s (phase {phase})")
                     dispatch(child)
     finally:
         for child in children:

@@ -47,7 +47,8 @@ Environment (all optional):
 - ``MORPHOMAP_FUZZ_FRESH`` (4) / ``MORPHOMAP_FUZZ_FRESH_3D`` (2): of those, fresh random seeds
   (printed in every failure message) instead of fixed ones.
 - ``MORPHOMAP_FUZZ_SEEDS``: exactly these seeds, e.g. ``"2d:17,203;3d:5"`` (no fixed or fresh ones).
-- ``MORPHOMAP_FUZZ_TIMEOUT_2D`` (60) / ``MORPHOMAP_FUZZ_TIMEOUT_3D`` (120): seconds per case.
+- ``MORPHOMAP_FUZZ_TIMEOUT_2D`` (60) / ``MORPHOMAP_FUZZ_TIMEOUT_3D`` (120): seconds per case (3
+  times as long for the ``fine`` variant).
 - ``MORPHOMAP_FUZZ_EXTRA_EVERY`` (20; 0: never).
 - ``MORPHOMAP_FUZZ_FINE_EVERY`` (8; 0: never).
 - ``MORPHOMAP_FUZZ_WORKERS`` (the usable cores, at most 2): child processes at a time. Each
