@@ -9,6 +9,7 @@ from scipy import ndimage
 from skimage import measure
 
 from frame_seeds import STYLES, rng_of, style_of
+from surface_shapes import signed_volume
 
 #: Voxel spacings (sz, sy, sx).
 SPACINGS_3D = ((2.0, 1.0, 1.0), (1.5, 1.0, 1.0), (1.0, 1.0, 1.0), (2.5, 0.8, 0.8), (1.0, 0.7, 1.0))
@@ -136,11 +137,6 @@ def _grow_3d(blob: Blob3D, rng) -> tuple[Blob3D, str]:
     return grown, kind
 
 
-def _signed_volume(vertices, faces):
-    a, b, c = vertices[faces[:, 0]], vertices[faces[:, 1]], vertices[faces[:, 2]]
-    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
-
-
 @dataclass
 class SurfacePair:
     seed: int
@@ -170,14 +166,14 @@ def _surface(volume, spacing, style_kind):
     verts, faces, _, _ = measure.marching_cubes(padded, 0.5, spacing=spacing)
     verts = (verts - pad * np.asarray(spacing))[:, ::-1]  # (z, y, x) -> (x, y, z)
     faces = np.asarray(faces, dtype=np.int64)
-    if style_kind != "unoriented" and _signed_volume(verts, faces) < 0:
+    if style_kind != "unoriented" and signed_volume(verts, faces) < 0:
         faces = faces[:, ::-1]
     mesh = trimesh.Trimesh(np.ascontiguousarray(verts, dtype=float), np.ascontiguousarray(faces), process=True)
     components = int(mesh.body_count)
     if style_kind == "careful" and components > 1:
         parts = mesh.split(only_watertight=False)
         if len(parts) > 1:
-            mesh = max(parts, key=lambda part: abs(_signed_volume(part.vertices, part.faces)))
+            mesh = max(parts, key=lambda part: abs(signed_volume(part.vertices, part.faces)))
     return mesh, components
 
 

@@ -46,3 +46,9 @@ def ellipsoid(subdivisions):
 
 def face_areas(v, f):
     return 0.5 * np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1)
+
+
+def signed_volume(vertices, faces):
+    """The volume a closed triangle surface encloses: positive where its faces turn outwards."""
+    a, b, c = vertices[faces[:, 0]], vertices[faces[:, 1]], vertices[faces[:, 2]]
+    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)

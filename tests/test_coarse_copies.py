@@ -8,7 +8,7 @@ from skimage import measure
 
 import morphomap as mm
 from morphomap import _progress
-from surface_shapes import icosphere
+from surface_shapes import icosphere, signed_volume
 
 
 def voxel_ball(radius):
@@ -20,8 +20,7 @@ def voxel_ball(radius):
     mask = (xx - centre) ** 2 + (yy - centre) ** 2 + (zz - centre) ** 2 < radius**2
     vertices, faces, _, _ = measure.marching_cubes(np.pad(mask, 1).astype(float), 0.5)
     vertices = vertices - 1 - centre
-    volume = np.einsum("ij,ij->i", vertices[faces[:, 0]], np.cross(vertices[faces[:, 1]], vertices[faces[:, 2]])).sum()
-    return vertices, (faces if volume > 0 else faces[:, ::-1]).astype(np.int64)
+    return vertices, (faces if signed_volume(vertices, faces) > 0 else faces[:, ::-1]).astype(np.int64)
 
 
 @pytest.fixture
