@@ -25,6 +25,7 @@
 
 #include "common/interrupt_check.hpp"
 #include "quality/folds.hpp"
+#include "surfaces/surface_util.hpp"
 
 #include <Eigen/Geometry>
 #include <Eigen/SparseCholesky>
@@ -40,7 +41,6 @@
 namespace morphomap::detail {
 namespace {
 
-using V3 = Eigen::Vector3d;
 using Tangents = Eigen::Matrix<double, 3, 2>;
 
 // A folded triangle's term weighs this much more: turning it back comes before evening the rest.
@@ -48,10 +48,6 @@ constexpr double kFoldWeight = 100.0;
 
 // Iterations over which the energy must fall by options.tolerance of itself to go on.
 constexpr std::size_t kWindow = 10;
-
-V3 corner(const Points3Ref& points, const FacesRef& faces, Index f, int i) {
-  return points.row(faces(f, i)).transpose();
-}
 
 double twice_area(const V3& a, const V3& b, const V3& c) { return (b - a).cross(c - a).norm(); }
 
@@ -72,16 +68,6 @@ double energy(const Points3Ref& ends, const FacesRef& faces, const std::vector<d
         return sum;
       },
       [](double a, double b) { return a + b; });
-}
-
-// Two unit vectors spanning the plane normal to n.
-Tangents tangents(const V3& n) {
-  const V3 seed = std::abs(n.x()) < 0.9 ? V3::UnitX() : V3::UnitY();
-  const V3 t1 = n.cross(seed).normalized();
-  Tangents t;
-  t.col(0) = t1;
-  t.col(1) = n.cross(t1);
-  return t;
 }
 
 using Triplet = Eigen::Triplet<double>;
@@ -243,7 +229,7 @@ Points3 even_ends(const Points3Ref& starts, const Points3Ref& ends, const FacesR
   for (int iteration = 0; iteration < options.max_iterations && e > 0; ++iteration) {
     check_interrupt();
     for (Index v = 0; v < count; ++v)
-      basis[static_cast<std::size_t>(v)] = tangents(normals2.row(on.faces(v)).transpose());
+      basis[static_cast<std::size_t>(v)] = tangent_frame(normals2.row(on.faces(v)).transpose());
     normal_equations(current, faces, scale, now, basis, entries, rhs);
     gauss.setFromTriplets(entries.begin(), entries.end());
     damping(faces, basis, 1e-3, smooth);

@@ -1,6 +1,7 @@
 // The last resort of "auto" in 3D (untangled_field.hpp).
 #include "mapping/untangled_field.hpp"
 
+#include "mapping/barrier_untangle.hpp"
 #include "mapping/even_surface.hpp"
 #include "mapping/surface_fields.hpp"
 #include "quality/folds.hpp"
@@ -11,9 +12,14 @@
 
 namespace morphomap::detail {
 
-std::optional<DisplacementField3> untangled(DisplacementField3 field, const FoldTest& test, const Points3Ref& v1,
-                                            const FacesRef& f1, const SurfaceIndex& index1, const Points3Ref& v2,
-                                            const FacesRef& f2, const SurfaceIndex& index2) {
+namespace {
+
+// The ends around the folds evened along S2 (untangled_field.hpp), the others held; none where
+// they are too many or folds remain.
+std::optional<DisplacementField3> evened_near_folds(DisplacementField3 field, const FoldTest& test,
+                                                    const Points3Ref& v1, const FacesRef& f1,
+                                                    const SurfaceIndex& index1, const Points3Ref& v2,
+                                                    const FacesRef& f2, const SurfaceIndex& index2) {
   const FacesRef faces = field.faces;
   // The ends that move: the folded triangles' corners and kUntangleRings rings around them.
   const std::vector<Index> moving = rows_near(field, test.folded(field.ends), kUntangleRings);
@@ -56,6 +62,23 @@ std::optional<DisplacementField3> untangled(DisplacementField3 field, const Fold
   const std::vector<char> folded = test.folded(field.ends);
   if (std::find(folded.begin(), folded.end(), 1) != folded.end()) return std::nullopt;
   for (const Index v : moving) field.methods[static_cast<std::size_t>(v)] = Method::optimal;
+  return field;
+}
+
+}  // namespace
+
+std::optional<DisplacementField3> untangled(DisplacementField3 field, const FoldTest& test, const Points3Ref& v1,
+                                            const FacesRef& f1, const SurfaceIndex& index1, const Points3Ref& v2,
+                                            const FacesRef& f2, const SurfaceIndex& index2) {
+  if (std::optional<DisplacementField3> evened = evened_near_folds(field, test, v1, f1, index1, v2, f2, index2))
+    return evened;
+  if (field.size() > kBarrierEnds) return std::nullopt;
+  const std::vector<char> none(static_cast<std::size_t>(field.size()), 0);
+  field.ends = barrier_untangled(field.starts, field.ends, field.faces, test, none, f2, v2, index2,
+                                 area_factor(v1, f1, v2, f2), kBarrierRounds);
+  const std::vector<char> folded = test.folded(field.ends);
+  if (std::find(folded.begin(), folded.end(), 1) != folded.end()) return std::nullopt;
+  std::fill(field.methods.begin(), field.methods.end(), Method::optimal);
   return field;
 }
 

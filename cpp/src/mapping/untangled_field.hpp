@@ -1,9 +1,11 @@
 #pragma once
 // The last resort of "auto" in 3D (surface_mapping.cpp): a complete field's folds turned back by
-// the descent of 3D "optimal" over the ends around them.
+// the descent of 3D "optimal" over the ends around them, else by the barrier untangling of every end.
 #include <morphomap/field.hpp>
 #include <morphomap/surface_queries.hpp>
 #include <morphomap/types.hpp>
+
+#include "mapping/coarse_field.hpp"
 
 #include <optional>
 
@@ -21,6 +23,14 @@ class FoldTest;
 constexpr int kUntangleRings = 10;
 constexpr Index kUntangleEnds = 5000;
 constexpr int kUntangleSteps = 40;
+// Where that leaves folds, every end moves along S2 by barrier_untangled (barrier_untangle.hpp),
+// at most kBarrierRounds rounds, on fields of at most kBarrierEnds vertices: every S1 that "auto"
+// does not map through coarse copies, and the copies themselves. The voxelised limb 270 -> 250 h
+// folds where 270's flat cap overhangs 250's, crushed onto its rim over a band wider than the
+// rings around the folds: held there, the ends around them could not make room, and the copies'
+// field untangled only with every end free, in 2 rounds (bench/README.md "Real 3D stages").
+constexpr int kBarrierRounds = 30;
+constexpr Index kBarrierEnds = 2 * kCoarseVertices;
 
 // `field`: complete, of S1's vertices (v1, f1) onto S2 (v2, f2); `test` its fold test.
 std::optional<DisplacementField3> untangled(DisplacementField3 field, const FoldTest& test, const Points3Ref& v1,

@@ -38,6 +38,16 @@ inline double area_factor(const Points3Ref& v1, const FacesRef& f1, const Points
   return surface_area(v2, f2) / surface_area(v1, f1);
 }
 
+// Two unit vectors spanning the plane normal to the unit vector n, in order round it (t1 x t2 = n).
+inline Eigen::Matrix<double, 3, 2> tangent_frame(const V3& n) {
+  const V3 seed = std::abs(n.x()) < 0.9 ? V3::UnitX() : V3::UnitY();
+  const V3 t1 = n.cross(seed).normalized();
+  Eigen::Matrix<double, 3, 2> t;
+  t.col(0) = t1;
+  t.col(1) = n.cross(t1);
+  return t;
+}
+
 // Barycentric coordinates of x (on or near the plane of triangle abc) in it; (1, 0, 0) where the
 // triangle has no area.
 inline V3 barycentric(const V3& a, const V3& b, const V3& c, const V3& x) {

@@ -1,0 +1,258 @@
+// The energy. Each triangle j maps its start, flattened and scaled by sqrt(alpha) (reference
+// edges R_j), onto its image seen in a plane normal to S2 under it (edges U_j): J = U_j R_j^-1,
+// D = det J the image's area over alpha times the start's, signed by its orientation on S2. With
+// chi(D, eps) = (D + sqrt(eps^2 + D^2)) / 2 > 0, a smooth stand-in for max(D, 0),
+//   f_eps(J) = ((1 - theta) |J|^2 + theta (D^2 + 1)) / (2 chi(D, eps)),
+// whose minimum over J is 1, at a rotation; as eps falls to 0 it grows without bound where D
+// nears 0 from above and is infinite where D <= 0. E = sum_j w_j f_eps(J_j), w_j the start's
+// share of the area. Each round minimises E at one eps by L-BFGS: the ends move within S2's
+// tangent planes and return onto S2 by closest point, every step found by a backtracking line
+// search on E after that projection. Between rounds eps falls as Garanzha et al. lower it: with
+// D- the smallest D and sigma = max(1 - E / E_before, 1/10) the round's relative progress,
+// mu = (1 - sigma) chi(D-, eps); eps = 2 sqrt(mu (mu - D-)) where D- < mu, else almost 0. The
+// frames (S2's normal under each image, as the fold test takes it, and under each end) are
+// refreshed each round, so one round's energy is one smooth function.
+#include "mapping/barrier_untangle.hpp"
+
+#include "common/interrupt_check.hpp"
+#include "quality/folds.hpp"
+#include "surfaces/surface_util.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <numeric>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace morphomap::detail {
+namespace {
+
+using M2 = Eigen::Matrix2d;
+using Frame = Eigen::Matrix<double, 3, 2>;
+
+// The share of shape against area in f: equal, so the untangled images keep their starts' shape
+// as much as their share of S2's area.
+constexpr double kShape = 0.5;
+// L-BFGS: the pairs of steps remembered, the iterations of one round, and the line search's
+// halvings of one step.
+constexpr int kMemory = 8;
+constexpr int kIterations = 60;
+constexpr int kHalvings = 20;
+// A step moves no end further than this fraction of the triangles' typical (scaled) start edge,
+// so that the projection back onto S2 stays on the sheet the end is on.
+constexpr double kReach = 0.5;
+// The regularisation once no triangle is near zero area.
+constexpr double kLeast = 1e-9;
+
+double chi(double d, double eps) { return 0.5 * (d + std::sqrt(eps * eps + d * d)); }
+double chi_slope(double d, double eps) { return 0.5 * (1.0 + d / std::sqrt(eps * eps + d * d)); }
+
+struct Triangle {
+  Index corner[3];
+  M2 inverse;     // R^-1, the inverse of the scaled start's edge matrix in its own plane
+  double weight;  // the start's share of the area of all the triangles untangled
+  Frame frame;    // two unit vectors spanning the plane normal to S2 under the image, in order
+};
+
+// The triangles touching a moving end, with their reference shapes (starts of no area left out).
+std::vector<Triangle> triangles_of(const Points3Ref& starts, const FacesRef& faces, const std::vector<char>& fixed,
+                                   double alpha, double& typical_edge) {
+  std::vector<Triangle> out;
+  std::vector<double> edges;
+  double total = 0.0;
+  for (Index f = 0; f < faces.rows(); ++f) {
+    if (fixed[faces(f, 0)] && fixed[faces(f, 1)] && fixed[faces(f, 2)]) continue;
+    const V3 a = corner(starts, faces, f, 0), e1 = corner(starts, faces, f, 1) - a,
+             e2 = corner(starts, faces, f, 2) - a;
+    const V3 n = e1.cross(e2);
+    if (!(n.norm() > 0)) continue;
+    const V3 x = e1.normalized(), y = n.normalized().cross(x);
+    M2 r;
+    r << e1.norm(), e2.dot(x), 0.0, e2.dot(y);
+    r *= std::sqrt(alpha);
+    Triangle t{{faces(f, 0), faces(f, 1), faces(f, 2)}, r.inverse(), 0.5 * n.norm(), Frame::Zero()};
+    total += t.weight;
+    out.push_back(t);
+    edges.push_back(std::sqrt(alpha) * e1.norm());
+  }
+  for (Triangle& t : out) t.weight /= total;
+  typical_edge = 0.0;
+  if (!edges.empty()) {
+    std::nth_element(edges.begin(), edges.begin() + static_cast<std::ptrdiff_t>(edges.size() / 2), edges.end());
+    typical_edge = edges[edges.size() / 2];
+  }
+  return out;
+}
+
+V3 face_normal(const Points3Ref& v2, const FacesRef& f2, Index face) {
+  const V3 a = corner(v2, f2, face, 0);
+  const V3 n = (corner(v2, f2, face, 1) - a).cross(corner(v2, f2, face, 2) - a);
+  return n.norm() > 0 ? V3(n.normalized()) : V3::Zero();
+}
+
+// Each triangle's frame: normal to the sum of S2's normals under its centroid and its corners
+// (`under`: the face of S2 each end lies on), as the fold test orients it.
+void refresh_frames(std::vector<Triangle>& tris, const Points3& x, const IndexVector& under, const FacesRef& f2,
+                    const Points3Ref& v2, const SurfaceIndex& index2) {
+  Points3 centroids(static_cast<Index>(tris.size()), 3);
+  for (std::size_t k = 0; k < tris.size(); ++k) {
+    const Triangle& t = tris[k];
+    centroids.row(static_cast<Index>(k)) = (x.row(t.corner[0]) + x.row(t.corner[1]) + x.row(t.corner[2])) / 3.0;
+  }
+  const IndexVector centre = index2.closest_points(centroids).faces;
+  for (std::size_t k = 0; k < tris.size(); ++k) {
+    Triangle& t = tris[k];
+    V3 n = face_normal(v2, f2, centre(static_cast<Index>(k)));
+    for (const Index c : t.corner) n += face_normal(v2, f2, under(c));
+    t.frame = tangent_frame(n.norm() > 0 ? V3(n.normalized()) : V3::UnitZ());
+  }
+}
+
+// E at x, its gradient with respect to every end (where `gradient`), and the smallest D.
+double energy(const std::vector<Triangle>& tris, const Points3& x, double eps, Points3* gradient, double& least) {
+  std::vector<double> values(tris.size());
+  std::vector<double> dets(tris.size());
+  std::vector<Eigen::Matrix3d> pulls(gradient != nullptr ? tris.size() : 0);
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, tris.size(), 512), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t k = r.begin(); k < r.end(); ++k) {
+          const Triangle& t = tris[k];
+          const V3 q0 = x.row(t.corner[0]).transpose();
+          M2 u;
+          u.col(0) = t.frame.transpose() * (x.row(t.corner[1]).transpose() - q0);
+          u.col(1) = t.frame.transpose() * (x.row(t.corner[2]).transpose() - q0);
+          const M2 j = u * t.inverse;
+          const double d = j.determinant(), c = chi(d, eps);
+          const double top = (1.0 - kShape) * j.squaredNorm() + kShape * (d * d + 1.0);
+          const double f = top / (2.0 * c);
+          values[k] = t.weight * f;
+          dets[k] = d;
+          if (gradient == nullptr) continue;
+          M2 cofactor;
+          cofactor << j(1, 1), -j(1, 0), -j(0, 1), j(0, 0);
+          const M2 d_j = ((1.0 - kShape) * j + kShape * d * cofactor) / c - (f * chi_slope(d, eps) / c) * cofactor;
+          const M2 d_u = t.weight * d_j * t.inverse.transpose();
+          Eigen::Matrix3d p;
+          p.col(1) = t.frame * d_u.col(0);
+          p.col(2) = t.frame * d_u.col(1);
+          p.col(0) = -p.col(1) - p.col(2);
+          pulls[k] = p;
+        }
+      });
+  least = dets.empty() ? 0.0 : *std::min_element(dets.begin(), dets.end());
+  if (gradient != nullptr) {
+    gradient->setZero(x.rows(), 3);
+    for (std::size_t k = 0; k < tris.size(); ++k) {
+      for (int i = 0; i < 3; ++i) gradient->row(tris[k].corner[i]) += pulls[k].col(i).transpose();
+    }
+  }
+  return std::accumulate(values.begin(), values.end(), 0.0);
+}
+
+}  // namespace
+
+Points3 barrier_untangled(const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, const FoldTest& test,
+                          const std::vector<char>& fixed, const FacesRef& f2, const Points3Ref& v2,
+                          const SurfaceIndex& index2, double alpha, int rounds) {
+  double edge = 0.0;
+  std::vector<Triangle> tris = triangles_of(starts, faces, fixed, alpha, edge);
+  std::vector<Index> moving, involved;
+  for (Index v = 0; v < starts.rows(); ++v) {
+    if (!fixed[static_cast<std::size_t>(v)]) moving.push_back(v);
+  }
+  for (Index f = 0; f < faces.rows(); ++f) {
+    if (!(fixed[faces(f, 0)] && fixed[faces(f, 1)] && fixed[faces(f, 2)])) involved.push_back(f);
+  }
+  SurfaceHits on = index2.closest_points(ends);
+  Points3 x = ends;
+  const Index m = static_cast<Index>(moving.size());
+  if (tris.empty() || m == 0 || !(edge > 0)) return x;
+  const auto unfolded = [&](const Points3& at) {
+    const std::vector<double> a = test.agreement(at, involved);
+    return std::none_of(a.begin(), a.end(), [](double v) { return v < 0; });
+  };
+  // The moving ends' gradient within S2's tangent plane at each, as one vector.
+  Points3 gradient;
+  const auto tangential = [&](const Points3& g, const IndexVector& under) {
+    Eigen::VectorXd out(3 * m);
+    for (Index k = 0; k < m; ++k) {
+      const V3 n = face_normal(v2, f2, under(moving[static_cast<std::size_t>(k)]));
+      const V3 d = g.row(moving[static_cast<std::size_t>(k)]).transpose();
+      out.segment<3>(3 * k) = d - n * n.dot(d);
+    }
+    return out;
+  };
+  double least = 0.0;
+  refresh_frames(tris, x, on.faces, f2, v2, index2);
+  energy(tris, x, 1.0, nullptr, least);
+  double eps = std::max(1.0, 2.0 * std::abs(least));
+  for (int round = 0; round < rounds; ++round) {
+    check_interrupt();
+    refresh_frames(tris, x, on.faces, f2, v2, index2);
+    double e = energy(tris, x, eps, &gradient, least);
+    const double e_before = e;
+    Eigen::VectorXd g = tangential(gradient, on.faces);
+    std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>> memory;  // (s, y) pairs
+    for (int iteration = 0; iteration < kIterations; ++iteration) {
+      // The L-BFGS direction (two-loop recursion), else steepest descent.
+      Eigen::VectorXd d = -g;
+      std::vector<double> rho(memory.size()), a(memory.size());
+      for (std::size_t i = memory.size(); i-- > 0;) {
+        rho[i] = 1.0 / memory[i].second.dot(memory[i].first);
+        a[i] = rho[i] * memory[i].first.dot(d);
+        d -= a[i] * memory[i].second;
+      }
+      if (!memory.empty()) d *= memory.back().first.dot(memory.back().second) / memory.back().second.squaredNorm();
+      for (std::size_t i = 0; i < memory.size(); ++i) d += (a[i] - rho[i] * memory[i].second.dot(d)) * memory[i].first;
+      if (!(d.dot(g) < 0)) d = -g, memory.clear();
+      double longest = 0.0;
+      for (Index k = 0; k < m; ++k) longest = std::max(longest, d.segment<3>(3 * k).norm());
+      if (!(longest > 0)) break;
+      double step = std::min(1.0, kReach * edge / longest);
+      const double slope = d.dot(g);
+      bool accepted = false;
+      for (int halving = 0; halving < kHalvings && !accepted; ++halving, step *= 0.5) {
+        Points3 tried = x;
+        for (Index k = 0; k < m; ++k)
+          tried.row(moving[static_cast<std::size_t>(k)]) += step * d.segment<3>(3 * k).transpose();
+        const SurfaceHits placed = index2.closest_points(tried(moving, Eigen::all));
+        for (Index k = 0; k < m; ++k) tried.row(moving[static_cast<std::size_t>(k)]) = placed.points.row(k);
+        Points3 g_new;
+        double least_new = 0.0;
+        const double e_new = energy(tris, tried, eps, &g_new, least_new);
+        if (!(e_new <= e + 1e-4 * step * slope)) continue;
+        accepted = true;
+        IndexVector under = on.faces;
+        for (Index k = 0; k < m; ++k) under(moving[static_cast<std::size_t>(k)]) = placed.faces(k);
+        const Eigen::VectorXd g_next = tangential(g_new, under);
+        Eigen::VectorXd s(3 * m);
+        for (Index k = 0; k < m; ++k) {
+          const Index v = moving[static_cast<std::size_t>(k)];
+          s.segment<3>(3 * k) = (tried.row(v) - x.row(v)).transpose();
+        }
+        const Eigen::VectorXd y = g_next - g;
+        if (s.dot(y) > 1e-12 * s.norm() * y.norm()) {
+          memory.emplace_back(s, y);
+          if (static_cast<int>(memory.size()) > kMemory) memory.pop_front();
+        }
+        x = std::move(tried);
+        on.faces = std::move(under);
+        g = g_next;
+        e = e_new;
+        least = least_new;
+      }
+      if (!accepted) break;
+    }
+    if (unfolded(x)) return x;
+    const double sigma = std::max(1.0 - e / e_before, 0.1);
+    const double mu = (1.0 - sigma) * chi(least, eps);
+    eps = least < mu ? 2.0 * std::sqrt(mu * (mu - least)) : kLeast;
+  }
+  return x;
+}
+
+}  // namespace morphomap::detail
