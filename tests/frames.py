@@ -41,12 +41,13 @@ from frames_3d import SurfacePair, surface_pair
 __all__ = ["STYLES", "CurvePair", "SurfacePair", "curve_pair", "pair", "style_of", "surface_pair"]
 
 
-def pair(dim: int, seed: int, style: str | None = None, fine: int = 1):
-    """``curve_pair`` (dim 2) or ``surface_pair`` (dim 3; ``fine``: its voxels that many times smaller)."""
+def pair(dim: int, seed: int, style: str | None = None, fine: int = 1, capped: bool = False):
+    """``curve_pair`` (dim 2) or ``surface_pair`` (dim 3; ``fine``: its voxels that many times smaller;
+    ``capped``: cut by a plane and closed by caps of long thin triangles)."""
     if dim == 2:
         return curve_pair(seed, style)
     if dim == 3:
-        return surface_pair(seed, style, fine)
+        return surface_pair(seed, style, fine, capped)
     raise ValueError(f"dim: expected 2 or 3, got {dim!r}")
 
 

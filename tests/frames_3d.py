@@ -8,6 +8,7 @@ import numpy as np
 from scipy import ndimage
 from skimage import measure
 
+from capped_frames import capped_pair
 from frame_seeds import STYLES, rng_of, style_of
 from surface_shapes import signed_volume
 
@@ -177,10 +178,12 @@ def _surface(volume, spacing, style_kind):
     return mesh, components
 
 
-def surface_pair(seed: int, style: str | None = None, fine: int = 1) -> SurfacePair:
+def surface_pair(seed: int, style: str | None = None, fine: int = 1, capped: bool = False) -> SurfacePair:
     """The 3D pair of frames of ``seed`` (style: ``style_of(seed)`` unless given). ``fine``: voxels
     that many times smaller along each axis, the same shapes (``fine=5``: some 10,000-55,000
-    vertices, the large surfaces the default maps through coarse copies)."""
+    vertices, the large surfaces the default maps through coarse copies). ``capped``: a careful
+    pair cut by one plane and closed by caps of long thin triangles (``capped_frames.py``; info
+    ``capped`` says whether the cut left one disc on each, else the pair is as it was)."""
     style = style_of(seed) if style is None else style
     if style not in STYLES:
         raise ValueError(f"style: expected one of {STYLES}, got {style!r}")
@@ -262,6 +265,13 @@ def surface_pair(seed: int, style: str | None = None, fine: int = 1) -> SurfaceP
     info["raw"] = None if style == "careful" else kind_of_style
     mesh1, parts1 = _surface(volumes[0], spacing, kind_of_style)
     mesh2, parts2 = _surface(volumes[1], spacing, kind_of_style)
+    if capped:
+        # Its own generator, so that the uncapped pair stays what it was.
+        cut = capped_pair(mesh1, mesh2, np.random.default_rng([int(seed), 3, 2])) if style == "careful" else None
+        info["capped"] = cut is not None
+        if cut is not None:
+            mesh1, mesh2 = cut[0], cut[1]
+            info.update(cut[2])
     as_tuple = rng.random() < 0.5  # half the pairs go in as (vertices, faces), half as Trimesh
     if as_tuple:
         s1 = (np.asarray(mesh1.vertices, dtype=float), np.asarray(mesh1.faces, dtype=np.int64))

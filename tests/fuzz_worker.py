@@ -96,10 +96,10 @@ class Worker:
         self.allowed = (ValueError, TypeError) + ((geometry,) if geometry is not None else ())
         self.geometry = geometry
 
-    def pair(self, dim, seed, style, fine):
-        key = (dim, seed, style, fine)
+    def pair(self, dim, seed, style, fine, capped):
+        key = (dim, seed, style, fine, capped)
         if self._cached is None or self._cached[0] != key:
-            self._cached = (key, self.frames.pair(dim, seed, style, fine))
+            self._cached = (key, self.frames.pair(dim, seed, style, fine, capped))
         return self._cached[1]
 
     def run(self, case):
@@ -110,7 +110,7 @@ class Worker:
         dim, seed, style = int(case["dim"]), int(case["seed"]), case.get("style")
         result = {"phase": "frames"}
         self.say({"id": ident, "phase": "frames"})
-        made = self.pair(dim, seed, style, int(case.get("fine", 1)))
+        made = self.pair(dim, seed, style, int(case.get("fine", 1)), bool(case.get("capped", False)))
         result["info"] = made.info
         result["identical"] = bool(made.identical)
         method, reverse = case["method"], bool(case.get("reverse", False))
@@ -264,6 +264,7 @@ def main(argv=None):
     parser.add_argument("--transform", action="store_true")
     parser.add_argument("--no-split", action="store_true")
     parser.add_argument("--fine", type=int, default=1, help="3D: voxels this many times finer")
+    parser.add_argument("--capped", action="store_true", help="3D: cut by a plane, closed by thin-triangle caps")
     args = parser.parse_args(argv)
     if args.serve:
         serve()
@@ -272,7 +273,8 @@ def main(argv=None):
         parser.error("give dim and seed (or --serve)")
     faulthandler.enable(all_threads=True)
     case = {"id": 0, "dim": args.dim, "seed": args.seed, "style": args.style, "method": args.method,
-            "reverse": args.reverse, "transform": args.transform, "split": not args.no_split, "fine": args.fine}
+            "reverse": args.reverse, "transform": args.transform, "split": not args.no_split, "fine": args.fine,
+            "capped": args.capped}
     print(json.dumps(case), flush=True)
     result = Worker(lambda message: print(json.dumps(_jsonable(message)), flush=True)).run(case)
     print(json.dumps(_jsonable(result), indent=1))

@@ -38,7 +38,9 @@ Variants: 2D, the 5 methods x {plain, reverse}, and on every ``MORPHOMAP_FUZZ_EX
 seed auto with ``transform=True`` and auto with ``split=False``; 3D, the 5 methods x {plain,
 reverse}, and on every ``MORPHOMAP_FUZZ_FINE_EVERY``-th seed auto on the same frames contoured
 from voxels 5 times finer (``fine``: 10,000-55,000 vertices, the surfaces the default maps through
-coarse copies).
+coarse copies), and on every ``MORPHOMAP_FUZZ_CAPPED_EVERY``-th seed auto on the frames cut by one
+plane and closed by caps of long thin triangles, as the real limb stages are (``capped``,
+``tests/capped_frames.py``; careful pairs only, the others run as they are).
 
 Environment (all optional):
 
@@ -51,6 +53,7 @@ Environment (all optional):
   times as long for the ``fine`` variant).
 - ``MORPHOMAP_FUZZ_EXTRA_EVERY`` (20; 0: never).
 - ``MORPHOMAP_FUZZ_FINE_EVERY`` (8; 0: never).
+- ``MORPHOMAP_FUZZ_CAPPED_EVERY`` (4; 0: never).
 - ``MORPHOMAP_FUZZ_WORKERS`` (the usable cores, at most 2): child processes at a time. Each
   case still runs alone in a child, so a crash or a hang names its seed whatever the number.
 - ``MORPHOMAP_FUZZ_REPORT``: a path; every case's record is appended there as a JSON line as
@@ -87,6 +90,7 @@ FRESH_2D = min(env_int("MORPHOMAP_FUZZ_FRESH", 4), PAIRS_2D)
 FRESH_3D = min(env_int("MORPHOMAP_FUZZ_FRESH_3D", 2), PAIRS_3D)
 EXTRA_EVERY = env_int("MORPHOMAP_FUZZ_EXTRA_EVERY", 20)
 FINE_EVERY = env_int("MORPHOMAP_FUZZ_FINE_EVERY", 8)
+CAPPED_EVERY = env_int("MORPHOMAP_FUZZ_CAPPED_EVERY", 4)
 #: How many times finer the voxels of the ``fine`` variant are.
 FINE = 5
 
@@ -147,13 +151,16 @@ def _cases(dim, seeds):
         if dim == 3 and FINE_EVERY and seed % FINE_EVERY == 0:
             cases.append(dict(dim=dim, seed=seed, style=style, method="auto", reverse=False,
                               transform=False, split=True, fine=FINE, variant="fine"))
+        if dim == 3 and CAPPED_EVERY and seed % CAPPED_EVERY == 0:
+            cases.append(dict(dim=dim, seed=seed, style=style, method="auto", reverse=False,
+                              transform=False, split=True, capped=True, variant="capped"))
     return cases
 
 
 def reproduce(record):
     """The one-liner that runs a case in the foreground."""
     flags = {"plain": "", "reverse": " --reverse", "transform": " --transform", "no_split": " --no-split",
-             "fine": f" --fine {record.get('fine', FINE)}"}
+             "fine": f" --fine {record.get('fine', FINE)}", "capped": " --capped"}
     return (f"python tests/fuzz_worker.py {record['dim']} {record['seed']} {record['method']}"
             f"{flags[record['variant']]}")
 

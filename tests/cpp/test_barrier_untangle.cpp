@@ -30,10 +30,10 @@ int main() {
   const Points3 twice = 2.0 * s.vertices;
   const morphomap::SurfaceIndex index1(s.vertices, s.faces), index2(twice, s.faces);
   const morphomap::detail::FoldTest test(s.vertices, s.faces, s.vertices, s.faces, index1, twice, s.faces, index2);
-  // The ends above z = 0.3 mirrored in the plane y = 0 (still on the doubled sphere).
+  // The ends above z = 0.7 mirrored in the plane y = 0 (still on the doubled sphere).
   Points3 mirrored = twice;
   for (Index v = 0; v < s.vertices.rows(); ++v) {
-    if (s.vertices(v, 2) > 0.3) mirrored(v, 1) = -mirrored(v, 1);
+    if (s.vertices(v, 2) > 0.7) mirrored(v, 1) = -mirrored(v, 1);
   }
   const Index before = folds(test, mirrored);
   CHECK(before > 100);
@@ -41,16 +41,20 @@ int main() {
 
   // Every end free.
   const std::vector<char> none(static_cast<std::size_t>(s.vertices.rows()), 0);
-  const Points3 free = morphomap::detail::barrier_untangled(s.vertices, mirrored, s.faces, test, none, s.faces, twice,
-                                                            index2, alpha, 30);
+  const auto untangled = morphomap::detail::barrier_untangled(s.vertices, mirrored, s.faces, test, none, s.faces, twice,
+                                                              index2, alpha, 30);
+  CHECK(untangled.has_value());
+  const Points3 free = untangled.value_or(mirrored);
   CHECK(folds(test, free) == 0);
   CHECK(index2.closest_points(free).distances.maxCoeff() < 1e-9);
 
   // The lower half held: it stays bit for bit, and the rest untangles around it.
   std::vector<char> held(static_cast<std::size_t>(s.vertices.rows()), 0);
   for (Index v = 0; v < s.vertices.rows(); ++v) held[static_cast<std::size_t>(v)] = s.vertices(v, 2) < 0.0;
-  const Points3 around = morphomap::detail::barrier_untangled(s.vertices, mirrored, s.faces, test, held, s.faces, twice,
-                                                              index2, alpha, 30);
+  const auto held_around = morphomap::detail::barrier_untangled(s.vertices, mirrored, s.faces, test, held, s.faces,
+                                                                twice, index2, alpha, 30);
+  CHECK(held_around.has_value());
+  const Points3 around = held_around.value_or(mirrored);
   CHECK(folds(test, around) == 0);
   CHECK(index2.closest_points(around).distances.maxCoeff() < 1e-9);
   for (Index v = 0; v < s.vertices.rows(); ++v) {

@@ -48,13 +48,27 @@ constexpr double kReach = 0.5;
 // The regularisation once no triangle is near zero area.
 constexpr double kLeast = 1e-9;
 
-double chi(double d, double eps) { return 0.5 * (d + std::sqrt(eps * eps + d * d)); }
-double chi_slope(double d, double eps) { return 0.5 * (1.0 + d / std::sqrt(eps * eps + d * d)); }
+// chi and its slope, for d < 0 in the forms without cancellation: where a sliver's image has
+// turned (D of -1e14 on a capped fuzz frame) the plain sum rounds to 0 and the energy to infinity.
+double chi(double d, double eps) {
+  const double r = std::sqrt(eps * eps + d * d);
+  return d >= 0 ? 0.5 * (d + r) : 0.5 * eps * eps / (r - d);
+}
+double chi_slope(double d, double eps) {
+  const double r = std::sqrt(eps * eps + d * d);
+  return d >= 0 ? 0.5 * (1.0 + d / r) : 0.5 * eps * eps / ((r - d) * r);
+}
+
+// An image below this share of its start's area times alpha does not count as untangled: the
+// fold test finds no orientation in an image of no area (a flat triangle is not folded), and two
+// boxes that only touch had every end drawn into one point before this bound.
+constexpr double kLeastImage = 1e-6;
 
 struct Triangle {
   Index corner[3];
   M2 inverse;     // R^-1, the inverse of the scaled start's edge matrix in its own plane
   double weight;  // the start's share of the area of all the triangles untangled
+  double least;   // the smallest area its image may have: kLeastImage alpha times the start's
   Frame frame;    // two unit vectors spanning the plane normal to S2 under the image, in order
 };
 
@@ -74,7 +88,14 @@ std::vector<Triangle> triangles_of(const Points3Ref& starts, const FacesRef& fac
     M2 r;
     r << e1.norm(), e2.dot(x), 0.0, e2.dot(y);
     r *= std::sqrt(alpha);
-    Triangle t{{faces(f, 0), faces(f, 1), faces(f, 2)}, r.inverse(), 0.5 * n.norm(), Frame::Zero()};
+    // A start with no height left after rounding (a cap's sliver) has no shape to keep: left out
+    // as the fold test leaves out a flat one.
+    if (!(r(1, 1) > 0) || !r.inverse().allFinite()) continue;
+    Triangle t{{faces(f, 0), faces(f, 1), faces(f, 2)},
+               r.inverse(),
+               0.5 * n.norm(),
+               kLeastImage * alpha * 0.5 * n.norm(),
+               Frame::Zero()};
     total += t.weight;
     out.push_back(t);
     edges.push_back(std::sqrt(alpha) * e1.norm());
@@ -155,9 +176,9 @@ double energy(const std::vector<Triangle>& tris, const Points3& x, double eps, P
 
 }  // namespace
 
-Points3 barrier_untangled(const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, const FoldTest& test,
-                          const std::vector<char>& fixed, const FacesRef& f2, const Points3Ref& v2,
-                          const SurfaceIndex& index2, double alpha, int rounds) {
+std::optional<Points3> barrier_untangled(const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces,
+                                         const FoldTest& test, const std::vector<char>& fixed, const FacesRef& f2,
+                                         const Points3Ref& v2, const SurfaceIndex& index2, double alpha, int rounds) {
   double edge = 0.0;
   std::vector<Triangle> tris = triangles_of(starts, faces, fixed, alpha, edge);
   std::vector<Index> moving, involved;
@@ -170,10 +191,15 @@ Points3 barrier_untangled(const Points3Ref& starts, const Points3Ref& ends, cons
   SurfaceHits on = index2.closest_points(ends);
   Points3 x = ends;
   const Index m = static_cast<Index>(moving.size());
-  if (tris.empty() || m == 0 || !(edge > 0)) return x;
-  const auto unfolded = [&](const Points3& at) {
+  if (tris.empty() || m == 0 || !(edge > 0)) return std::nullopt;
+  // Untangled: no triangle folded, and every image of a start with area keeps some area.
+  const auto untangled_at = [&](const Points3& at) {
     const std::vector<double> a = test.agreement(at, involved);
-    return std::none_of(a.begin(), a.end(), [](double v) { return v < 0; });
+    if (std::any_of(a.begin(), a.end(), [](double v) { return v < 0; })) return false;
+    return std::all_of(tris.begin(), tris.end(), [&](const Triangle& t) {
+      const V3 q0 = at.row(t.corner[0]).transpose();
+      return 0.5 * (at.row(t.corner[1]).transpose() - q0).cross(at.row(t.corner[2]).transpose() - q0).norm() > t.least;
+    });
   };
   // The moving ends' gradient within S2's tangent plane at each, as one vector.
   Points3 gradient;
@@ -209,6 +235,7 @@ Points3 barrier_untangled(const Points3Ref& starts, const Points3Ref& ends, cons
       if (!memory.empty()) d *= memory.back().first.dot(memory.back().second) / memory.back().second.squaredNorm();
       for (std::size_t i = 0; i < memory.size(); ++i) d += (a[i] - rho[i] * memory[i].second.dot(d)) * memory[i].first;
       if (!(d.dot(g) < 0)) d = -g, memory.clear();
+      if (!d.allFinite()) break;  // a slope that overflowed (a sliver against a huge image)
       double longest = 0.0;
       for (Index k = 0; k < m; ++k) longest = std::max(longest, d.segment<3>(3 * k).norm());
       if (!(longest > 0)) break;
@@ -219,12 +246,13 @@ Points3 barrier_untangled(const Points3Ref& starts, const Points3Ref& ends, cons
         Points3 tried = x;
         for (Index k = 0; k < m; ++k)
           tried.row(moving[static_cast<std::size_t>(k)]) += step * d.segment<3>(3 * k).transpose();
+        if (!tried.allFinite()) continue;
         const SurfaceHits placed = index2.closest_points(tried(moving, Eigen::all));
         for (Index k = 0; k < m; ++k) tried.row(moving[static_cast<std::size_t>(k)]) = placed.points.row(k);
         Points3 g_new;
         double least_new = 0.0;
         const double e_new = energy(tris, tried, eps, &g_new, least_new);
-        if (!(e_new <= e + 1e-4 * step * slope)) continue;
+        if (!(e_new <= e + 1e-4 * step * slope) || !g_new.allFinite()) continue;
         accepted = true;
         IndexVector under = on.faces;
         for (Index k = 0; k < m; ++k) under(moving[static_cast<std::size_t>(k)]) = placed.faces(k);
@@ -247,12 +275,12 @@ Points3 barrier_untangled(const Points3Ref& starts, const Points3Ref& ends, cons
       }
       if (!accepted) break;
     }
-    if (unfolded(x)) return x;
+    if (untangled_at(x)) return x;
     const double sigma = std::max(1.0 - e / e_before, 0.1);
     const double mu = (1.0 - sigma) * chi(least, eps);
     eps = least < mu ? 2.0 * std::sqrt(mu * (mu - least)) : kLeast;
   }
-  return x;
+  return std::nullopt;
 }
 
 }  // namespace morphomap::detail

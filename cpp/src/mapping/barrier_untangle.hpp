@@ -10,6 +10,7 @@
 #include <morphomap/surface_queries.hpp>
 #include <morphomap/types.hpp>
 
+#include <optional>
 #include <vector>
 
 namespace morphomap::detail {
@@ -20,9 +21,10 @@ class FoldTest;
 // S2 by rounds of L-BFGS on the regularised energy, the regularisation lowered between rounds as
 // the paper's rule says, until `test` finds no triangle folded (at most `rounds` rounds). alpha =
 // area(S2) / area(S1): each triangle's image aims at its start's area times alpha. Returns the
-// ends reached (still folded where the rounds ran out: the caller tests). Polls interrupts.
-Points3 barrier_untangled(const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces, const FoldTest& test,
-                          const std::vector<char>& fixed, const FacesRef& f2, const Points3Ref& v2,
-                          const SurfaceIndex& index2, double alpha, int rounds);
+// ends reached once no triangle is folded and every image of a start with area keeps at least
+// kLeastImage of it (barrier_untangle.cpp), else none. Polls interrupts.
+std::optional<Points3> barrier_untangled(const Points3Ref& starts, const Points3Ref& ends, const FacesRef& faces,
+                                         const FoldTest& test, const std::vector<char>& fixed, const FacesRef& f2,
+                                         const Points3Ref& v2, const SurfaceIndex& index2, double alpha, int rounds);
 
 }  // namespace morphomap::detail

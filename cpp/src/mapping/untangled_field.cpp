@@ -8,6 +8,7 @@
 #include "surfaces/surface_util.hpp"
 
 #include <algorithm>
+#include <utility>
 #include <vector>
 
 namespace morphomap::detail {
@@ -74,10 +75,10 @@ std::optional<DisplacementField3> untangled(DisplacementField3 field, const Fold
     return evened;
   if (field.size() > kBarrierEnds) return std::nullopt;
   const std::vector<char> none(static_cast<std::size_t>(field.size()), 0);
-  field.ends = barrier_untangled(field.starts, field.ends, field.faces, test, none, f2, v2, index2,
-                                 area_factor(v1, f1, v2, f2), kBarrierRounds);
-  const std::vector<char> folded = test.folded(field.ends);
-  if (std::find(folded.begin(), folded.end(), 1) != folded.end()) return std::nullopt;
+  std::optional<Points3> ends = barrier_untangled(field.starts, field.ends, field.faces, test, none, f2, v2, index2,
+                                                  area_factor(v1, f1, v2, f2), kBarrierRounds);
+  if (!ends) return std::nullopt;
+  field.ends = std::move(*ends);
   std::fill(field.methods.begin(), field.methods.end(), Method::optimal);
   return field;
 }
