@@ -28,7 +28,7 @@ constexpr int kUntangleSteps = 40;
 // does not map through coarse copies, and the copies themselves. The voxelised limb 270 -> 250 h
 // folds where 270's flat cap overhangs 250's, crushed onto its rim over a band wider than the
 // rings around the folds: held there, the ends around them could not make room, and the copies'
-// field untangled only with every end free, in 2-3 rounds (bench/README.md "Real 3D stages").
+// field untangled only with every end free (bench/README.md "Real 3D stages").
 constexpr int kBarrierRounds = 30;
 constexpr Index kBarrierEnds = 2 * kCoarseVertices;
 
