@@ -131,7 +131,8 @@ def map_surfaces(s1, s2, method="auto", *, reverse=False, mesh_size=None, repeat
         ``"optimal"``); where folds remain, on a field of at most 10,000 vertices (an ``s1``
         mapped without coarse copies, or the copies), it moves every end along ``s2`` to lower
         a distortion energy with a barrier at zero area (the untangling of Garanzha et al. 2021,
-        at most 30 rounds; every vector labelled ``"optimal"``), else gives up.
+        at most 30 rounds; kept only where every image keeps some area; every vector labelled
+        ``"optimal"``), else gives up.
         ``field.method`` says which way each vector came.
         ``"optimal"`` (beyond the paper): ``"auto"``'s field, then its ends moved along ``s2`` so
         that every triangle's image keeps its share of ``s2``'s area: E = sum_j (A'_j / (alpha

@@ -24,8 +24,9 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
-#include <limits>
 #include <numeric>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include <tbb/blocked_range.h>

@@ -19,7 +19,7 @@ class FoldTest;
 
 // `ends` (one row per row of `starts`, all finite, on (v2, f2)), the rows not `fixed` moved along
 // S2 by rounds of L-BFGS on the regularised energy, the regularisation lowered between rounds as
-// the paper's rule says, until `test` finds no triangle folded (at most `rounds` rounds); each
+// Garanzha et al. lower it, until `test` finds no triangle folded (at most `rounds` rounds); each
 // image seen in a frame that follows its corners' faces of S2, else, where that does not
 // untangle, in one taken once a round with its centroid's face too. alpha =
 // area(S2) / area(S1): each triangle's image aims at its start's area times alpha. Returns the
