@@ -113,16 +113,21 @@ std::vector<Triangle> triangles_of(const Points3Ref& starts, const FacesRef& fac
   return out;
 }
 
-V3 face_normal(const Points3Ref& v2, const FacesRef& f2, Index face) {
-  const V3 a = corner(v2, f2, face, 0);
-  const V3 n = (corner(v2, f2, face, 1) - a).cross(corner(v2, f2, face, 2) - a);
-  return n.norm() > 0 ? V3(n.normalized()) : V3::Zero();
+// The frame of an image: normal to `sum`, the sum of S2's unit face normals under it (any frame
+// where they cancel).
+Frame frame_normal_to(const V3& sum) { return tangent_frame(sum.norm() > 0 ? V3(sum.normalized()) : V3::UnitZ()); }
+
+// `sum` plus S2's unit normals (`normals2`, per face) under a triangle's corners (`under`: the
+// face of S2 each end lies on).
+V3 normals_under_corners(const Triangle& t, const IndexVector& under, const Points3& normals2, V3 sum = V3::Zero()) {
+  for (const Index c : t.corner) sum += normals2.row(under(c)).transpose();
+  return sum;
 }
 
-// Each triangle's frame: normal to the sum of S2's normals under its centroid and its corners
-// (`under`: the face of S2 each end lies on), as the fold test orients it.
-void refresh_frames(std::vector<Triangle>& tris, const Points3& x, const IndexVector& under, const FacesRef& f2,
-                    const Points3Ref& v2, const SurfaceIndex& index2) {
+// Each triangle's frame from S2's normals under its centroid and its corners, as the fold test
+// orients it.
+void refresh_frames(std::vector<Triangle>& tris, const Points3& x, const IndexVector& under, const Points3& normals2,
+                    const SurfaceIndex& index2) {
   Points3 centroids(static_cast<Index>(tris.size()), 3);
   for (std::size_t k = 0; k < tris.size(); ++k) {
     const Triangle& t = tris[k];
@@ -131,20 +136,15 @@ void refresh_frames(std::vector<Triangle>& tris, const Points3& x, const IndexVe
   const IndexVector centre = index2.closest_points(centroids).faces;
   for (std::size_t k = 0; k < tris.size(); ++k) {
     Triangle& t = tris[k];
-    V3 n = face_normal(v2, f2, centre(static_cast<Index>(k)));
-    for (const Index c : t.corner) n += face_normal(v2, f2, under(c));
-    t.frame = tangent_frame(n.norm() > 0 ? V3(n.normalized()) : V3::UnitZ());
+    t.frame = frame_normal_to(
+        normals_under_corners(t, under, normals2, normals2.row(centre(static_cast<Index>(k))).transpose()));
   }
 }
 
 // Each triangle's frame from S2's normals under its corners alone, as they move: no query, so
 // it can follow the ends at every evaluation.
-void corner_frames(std::vector<Triangle>& tris, const IndexVector& under, const FacesRef& f2, const Points3Ref& v2) {
-  for (Triangle& t : tris) {
-    V3 n = V3::Zero();
-    for (const Index c : t.corner) n += face_normal(v2, f2, under(c));
-    t.frame = tangent_frame(n.norm() > 0 ? V3(n.normalized()) : V3::UnitZ());
-  }
+void corner_frames(std::vector<Triangle>& tris, const IndexVector& under, const Points3& normals2) {
+  for (Triangle& t : tris) t.frame = frame_normal_to(normals_under_corners(t, under, normals2));
 }
 
 // E at x, its gradient with respect to every end (where `gradient`), and the smallest D.
@@ -204,6 +204,7 @@ std::optional<Points3> barrier_untangled(const Points3Ref& starts, const Points3
   }
   const Index m = static_cast<Index>(moving.size());
   if (tris.empty() || m == 0 || !(edge > 0)) return std::nullopt;
+  const Points3 normals2 = unit_face_normals(v2, f2);  // once: the frames take them at every evaluation
   // Untangled: no triangle folded, and every image of a start with area keeps some area.
   const auto untangled_at = [&](const Points3& at) {
     const std::vector<double> a = test.agreement(at, involved);
@@ -223,7 +224,7 @@ std::optional<Points3> barrier_untangled(const Points3Ref& starts, const Points3
     const auto tangential = [&](const Points3& g, const IndexVector& under) {
       Eigen::VectorXd out(3 * m);
       for (Index k = 0; k < m; ++k) {
-        const V3 n = face_normal(v2, f2, under(moving[static_cast<std::size_t>(k)]));
+        const V3 n = normals2.row(under(moving[static_cast<std::size_t>(k)])).transpose();
         const V3 d = g.row(moving[static_cast<std::size_t>(k)]).transpose();
         out.segment<3>(3 * k) = d - n * n.dot(d);
       }
@@ -232,9 +233,9 @@ std::optional<Points3> barrier_untangled(const Points3Ref& starts, const Points3
     double least = 0.0;
     const auto set_frames = [&](const Points3& at, const IndexVector& under) {
       if (follow)
-        corner_frames(tris, under, f2, v2);
+        corner_frames(tris, under, normals2);
       else
-        refresh_frames(tris, at, under, f2, v2, index2);
+        refresh_frames(tris, at, under, normals2, index2);
     };
     set_frames(x, on.faces);
     energy(tris, x, 1.0, nullptr, least);

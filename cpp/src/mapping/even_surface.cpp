@@ -197,11 +197,7 @@ Points3 even_ends(const Points3Ref& starts, const Points3Ref& ends, const FacesR
     const double a = twice_area(corner(starts, faces, f, 0), corner(starts, faces, f, 1), corner(starts, faces, f, 2));
     if (a > 0) scale[static_cast<std::size_t>(f)] = 1.0 / (alpha * a);
   }
-  Points3 normals2(f2.rows(), 3);
-  for (Index f = 0; f < f2.rows(); ++f) {
-    const V3 n = (corner(v2, f2, f, 1) - corner(v2, f2, f, 0)).cross(corner(v2, f2, f, 2) - corner(v2, f2, f, 0));
-    normals2.row(f) = (n.norm() > 0 ? V3(n.normalized()) : V3::Zero()).transpose();
-  }
+  const Points3 normals2 = unit_face_normals(v2, f2);
   std::vector<Index> every(static_cast<std::size_t>(faces.rows()));
   for (Index f = 0; f < faces.rows(); ++f) every[static_cast<std::size_t>(f)] = f;
   // The ends as given (on S2 already: projected again, a nearly flat triangle's orientation may

@@ -72,10 +72,7 @@ void require_on(const Points3Ref& points, const Points3Ref& v, const SurfaceInde
 // was not built from this surface.
 V3 unit_face_normal(const Points3Ref& v, const FacesRef& f, Index face, const char* name) {
   if (face < 0 || face >= f.rows()) detail::invalid(name, "the surface index does not match its faces");
-  const V3 a = detail::corner(v, f, face, 0);
-  const V3 n = (detail::corner(v, f, face, 1) - a).cross(detail::corner(v, f, face, 2) - a);
-  const double length = n.norm();
-  return length > 0 ? V3(n / length) : V3::Zero();
+  return detail::unit_face_normal(v, f, face);
 }
 
 // For each of `triangles` (rows of `faces` over `points`, every corner finite), the sum nu of the

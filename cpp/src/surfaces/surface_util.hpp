@@ -38,6 +38,21 @@ inline double area_factor(const Points3Ref& v1, const FacesRef& f1, const Points
   return surface_area(v2, f2) / surface_area(v1, f1);
 }
 
+// Unit normal of face `face` of (v, f), by its corners' order; zero where it has no area.
+inline V3 unit_face_normal(const Points3Ref& v, const FacesRef& f, Index face) {
+  const V3 a = corner(v, f, face, 0);
+  const V3 n = (corner(v, f, face, 1) - a).cross(corner(v, f, face, 2) - a);
+  const double length = n.norm();
+  return length > 0 ? V3(n / length) : V3::Zero();
+}
+
+// unit_face_normal of every face of (v, f), one row each.
+inline Points3 unit_face_normals(const Points3Ref& v, const FacesRef& f) {
+  Points3 normals(f.rows(), 3);
+  for (Index face = 0; face < f.rows(); ++face) normals.row(face) = unit_face_normal(v, f, face).transpose();
+  return normals;
+}
+
 // Two unit vectors spanning the plane normal to the unit vector n, in order round it (t1 x t2 = n).
 inline Eigen::Matrix<double, 3, 2> tangent_frame(const V3& n) {
   const V3 seed = std::abs(n.x()) < 0.9 ? V3::UnitX() : V3::UnitY();
